@@ -1,0 +1,136 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// pcl::MedialScaffoldReconstruction: a PCL surface-reconstruction class over
+// the pcl_ms core (medial-scaffold gap transforms, Leymarie/Chang/Kimia).
+#pragma once
+
+#include <pcl_ms/types.h>
+
+#include <pcl/PolygonMesh.h>
+#include <pcl/Vertices.h>
+#include <pcl/point_cloud.h>
+#include <pcl/surface/reconstruction.h>
+
+#include <string>
+#include <vector>
+
+namespace pcl {
+
+/** \brief Interpolating surface reconstruction by greedy gap transforms on
+ * the medial scaffold (Delaunay triangles ranked by shape and shock-curve
+ * length, accepted under 2-manifold rules, with error recovery).
+ *
+ * Handles open surfaces with boundaries, non-orientable surfaces, sharp
+ * features and uneven sampling; needs no normals. The output mesh's cloud is
+ * the input cloud with all its fields and the polygons index it directly.
+ *
+ * \code
+ * pcl::MedialScaffoldReconstruction<pcl::PointXYZ> msr;
+ * msr.setInputCloud(cloud);
+ * pcl::PolygonMesh mesh;
+ * msr.reconstruct(mesh);
+ * \endcode
+ */
+template <typename PointInT>
+class MedialScaffoldReconstruction : public SurfaceReconstruction<PointInT> {
+public:
+  using Ptr = shared_ptr<MedialScaffoldReconstruction<PointInT>>;
+  using ConstPtr = shared_ptr<const MedialScaffoldReconstruction<PointInT>>;
+  using NormalCloud = pcl::PointCloud<pcl::Normal>;
+
+  using SurfaceReconstruction<PointInT>::reconstruct;
+
+  MedialScaffoldReconstruction();
+
+  /** \brief Guarded: reports an error and returns an empty mesh when no input
+   * was set (PCL's base class would dereference a null cloud). */
+  void reconstruct(pcl::PolygonMesh &output) override;
+  void reconstruct(pcl::PointCloud<PointInT> &points,
+                   std::vector<pcl::Vertices> &polygons) override;
+
+  /** \brief d_max = rho * d_med caps triangle sides (default 10; the paper
+   * uses 5-15, 30 closes the bunny's base holes). Must be > 0. */
+  void setRho(double rho) { parameters_.rho = rho; }
+  double getRho() const { return parameters_.rho; }
+
+  /** \brief Close boundary loops of at most \a max_edges edges with Delaunay
+   * triangles (default 0 = off). */
+  void setFillHoles(int max_edges) { parameters_.fill_holes_max_edges = max_edges; }
+  int getFillHoles() const { return parameters_.fill_holes_max_edges; }
+
+  /** \brief Use normals to prefer candidates aligned with them (default
+   * off). Normals come from setInputNormals, else from the point type. */
+  void setUseNormals(bool use) { parameters_.use_normals = use; }
+  bool getUseNormals() const { return parameters_.use_normals; }
+
+  /** \brief Weight kappa of the normal term (default 1). Must be >= 0. */
+  void setNormalWeight(double kappa) { parameters_.normal_weight = kappa; }
+  double getNormalWeight() const { return parameters_.normal_weight; }
+
+  /** \brief Normals for the input cloud, one per point (same size). */
+  void setInputNormals(const NormalCloud::ConstPtr &normals) { normals_ = normals; }
+  NormalCloud::ConstPtr getInputNormals() const { return normals_; }
+
+  /** \brief Relative cost gap under which competitors are delayed (default
+   * 0.05). In [0, 1). */
+  void setCloseRankingTolerance(double tolerance) {
+    parameters_.close_ranking_tolerance = tolerance;
+  }
+  double getCloseRankingTolerance() const { return parameters_.close_ranking_tolerance; }
+
+  /** \brief Cost factor of a delay (default 1.2, must be > 1) and number of
+   * delays per candidate before it is decided anyway (default 5, >= 0). */
+  void setDelayFactor(double factor) { parameters_.delay_factor = factor; }
+  double getDelayFactor() const { return parameters_.delay_factor; }
+  void setMaxDelays(int delays) { parameters_.max_delays = delays; }
+  int getMaxDelays() const { return parameters_.max_delays; }
+
+  /** \brief Undo accepted triangles that later turn out costlier than a
+   * conflicting candidate (default on). */
+  void setErrorRecovery(bool enabled) { parameters_.error_recovery = enabled; }
+  bool getErrorRecovery() const { return parameters_.error_recovery; }
+
+  /** \brief Threads for the parallel stages (default 1, 0 = all cores). The
+   * mesh does not depend on it. */
+  void setNumberOfThreads(int threads) { parameters_.num_threads = threads; }
+  int getNumberOfThreads() const { return parameters_.num_threads; }
+
+  /** \brief All parameters at once (core struct). */
+  void setParameters(const pcl_ms::Parameters &parameters) { parameters_ = parameters; }
+  const pcl_ms::Parameters &getParameters() const { return parameters_; }
+
+  /** \brief Details of the last reconstruct(): boundary loops, components
+   * and their orientability, counts per pass, timings per stage. */
+  const pcl_ms::Result &getResult() const { return result_; }
+  /** \brief Boundary loops of the last result, as indices into the input. */
+  std::vector<pcl::Vertices> getBoundaryLoops() const;
+  /** \brief Empty after a successful reconstruct(), else the reason. */
+  const std::string &getErrorMessage() const { return error_message_; }
+
+protected:
+  std::string getClassName() const override {
+    return "MedialScaffoldReconstruction";
+  }
+
+  void performReconstruction(pcl::PolygonMesh &output) override;
+  void performReconstruction(pcl::PointCloud<PointInT> &points,
+                             std::vector<pcl::Vertices> &polygons) override;
+
+private:
+  /** \brief Runs the core on input_/indices_; false (and PCL_ERROR) on failure. */
+  bool runCore(std::vector<pcl::Vertices> &polygons);
+
+  pcl_ms::Parameters parameters_;
+  NormalCloud::ConstPtr normals_;
+  pcl_ms::Result result_;
+  std::string error_message_;
+
+  using SurfaceReconstruction<PointInT>::input_;
+  using SurfaceReconstruction<PointInT>::indices_;
+  using SurfaceReconstruction<PointInT>::check_tree_;
+};
+
+} // namespace pcl
+
+#ifdef PCL_NO_PRECOMPILE
+#include <pcl_ms/impl/medial_scaffold_reconstruction.hpp>
+#endif

@@ -1,0 +1,105 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Plain types shared by every stage of the core. The core never sees PCL point
+// types: points come in as strided float arrays, triangles go out as indices.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pcl_ms {
+
+using VertexIndex = std::uint32_t;
+using Triangle = std::array<VertexIndex, 3>;
+
+/// Read-only view of the user's points: `size` records, `stride` bytes apart,
+/// each starting with three consecutive floats x, y, z (true for every PCL
+/// point type, and for a plain float[3] array with stride 12).
+struct PointView {
+  const float *xyz = nullptr;
+  std::size_t size = 0;
+  std::size_t stride = 3 * sizeof(float);
+  /// Optional normals, same layout rules (nx, ny, nz consecutive floats).
+  const float *normals = nullptr;
+  std::size_t normal_stride = 3 * sizeof(float);
+  /// Optional subset of records to use (like pcl::PCLBase::setIndices).
+  const std::vector<int> *indices = nullptr;
+};
+
+/// All tuning knobs of the method; defaults follow ALGORITHM.md.
+struct Parameters {
+  /// d_max = rho * d_med: candidates with a side >= d_max are never queued.
+  double rho = 10.0;
+  /// Close boundary loops of at most this many edges (0 = off).
+  int fill_holes_max_edges = 0;
+  /// Use the input normals to prefer candidates aligned with them.
+  bool use_normals = false;
+  /// kappa in eps1 * (1 + kappa (1 - mean |n_T . n_v|)).
+  double normal_weight = 1.0;
+  /// Relative cost gap under which two competing candidates are delayed.
+  double close_ranking_tolerance = 0.05;
+  /// Factor applied to a delayed candidate's cost.
+  double delay_factor = 1.2;
+  /// Delays per candidate before it is decided anyway.
+  int max_delays = 5;
+  /// Undo accepted triangles whose cost grew above a conflicting candidate's.
+  bool error_recovery = true;
+  /// Worker threads for the parallel stages; 0 = all cores. Never changes the result.
+  int num_threads = 1;
+
+  /// Empty when valid, else a one-line reason.
+  std::string validate() const;
+};
+
+/// What one greedy pass did.
+struct PassStatistics {
+  std::size_t popped = 0;
+  std::size_t accepted = 0;
+  std::size_t undone = 0;
+  std::size_t delayed = 0;
+  std::size_t rejected = 0;
+  std::size_t demoted = 0;
+};
+
+/// Wall-clock seconds per stage.
+struct StageTimings {
+  double prepare = 0;      // validation, NaN and duplicate removal
+  double delaunay = 0;     // Delaunay tetrahedralisation
+  double scaffold = 0;     // candidates, types, costs, candidate graph
+  double greedy = 0;       // passes 1 and 2 with clean-up
+  double finish = 0;       // manifold sweep, holes, orientation, loops
+  double total = 0;
+};
+
+/// Everything the core reports after a run. Indices refer to the user's
+/// records (PointView::xyz), never to a filtered copy.
+struct Result {
+  std::vector<Triangle> triangles;
+  /// Closed boundary curves, each a cyclic list of vertex indices.
+  std::vector<std::vector<VertexIndex>> boundary_loops;
+  /// Connected component of each triangle (by shared edges), 0-based.
+  std::vector<std::uint32_t> triangle_component;
+  /// One flag per component: false where no consistent orientation exists.
+  std::vector<bool> component_orientable;
+
+  std::size_t input_points = 0;     // records considered (after indices)
+  std::size_t invalid_points = 0;   // NaN / Inf, skipped
+  std::size_t duplicate_points = 0; // exact repeats, merged onto the first
+  std::size_t used_points = 0;      // distinct points that went into the scaffold
+  bool planar = false;              // all points on one plane: 2-D Delaunay used
+
+  std::size_t candidates_type1 = 0, candidates_type2 = 0, candidates_type3 = 0;
+  std::size_t candidates_oversize = 0;
+  double d_med = 0, d_max = 0;
+  PassStatistics pass1, pass2;
+  std::size_t cleanup_undone = 0;   // flaps/isolated triangles and final sweep
+  std::size_t holes_filled = 0;
+  StageTimings timings;
+
+  std::size_t numberOfComponents() const { return component_orientable.size(); }
+  std::size_t numberOfNonOrientableComponents() const;
+};
+
+} // namespace pcl_ms
