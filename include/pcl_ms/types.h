@@ -95,6 +95,7 @@ struct Result {
   double d_med = 0, d_max = 0;
   PassStatistics pass1, pass2;
   std::size_t cleanup_undone = 0;   // flaps/isolated triangles and final sweep
+  std::size_t swapped_pairs = 0;    // non-Delaunay quads re-triangulated
   std::size_t holes_filled = 0;
   StageTimings timings;
 

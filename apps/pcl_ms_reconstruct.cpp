@@ -1,0 +1,335 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// pcl_ms_reconstruct: meshes a point cloud file with
+// pcl::MedialScaffoldReconstruction and saves the mesh, in the manner of
+// PCL's own command-line tools. On any failure it prints exactly one line,
+// "error: <reason>", on stderr and exits non-zero, so scripts can rely on it.
+#include <pcl_ms/io.h>
+#include <pcl_ms/medial_scaffold_reconstruction.h>
+
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+#include <pcl/console/time.h>
+#include <pcl/conversions.h>
+#include <pcl/point_types.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace {
+
+using pcl::console::print_highlight;
+using pcl::console::print_info;
+using pcl::console::print_value;
+
+enum ExitCode { kSuccess = 0, kBadArguments = 1, kIoFailure = 2, kReconstructionFailure = 3 };
+
+struct Options {
+  std::string input, output;
+  double rho = 10.0;
+  int fill_holes = 0;
+  bool normals = false;
+  int threads = 1;
+  bool quiet = false;
+  bool help = false;
+};
+
+void printHelp(const char *program) {
+  print_info("Meshes a point cloud by greedy gap transforms on its medial scaffold.\n\n");
+  print_info("Usage: %s input output [options]\n\n", program);
+  print_info("  input   point cloud: .pcd, .ply, .xyz or .txt (x y z [nx ny nz] per line)\n");
+  print_info("  output  mesh: .ply (binary), .vtk or .obj; its vertices are the input points, in\n"
+             "          order, with colours and normals where the format can hold them\n\n");
+  print_info("Options:\n");
+  print_info("  -rho X          no triangle side reaches X * d_med, d_med being the median\n"
+             "                  circumradius of the candidate triangles (default ");
+  print_value("10");
+  print_info(")\n");
+  print_info("  -fill_holes K   close boundary loops of at most K edges (default ");
+  print_value("0");
+  print_info(" = off)\n");
+  print_info("  -normals        use the cloud's normal_x/y/z fields to guide the surface\n");
+  print_info("  -threads N      threads for the parallel stages, 0 = all cores (default ");
+  print_value("1");
+  print_info(")\n");
+  print_info("  -q              quiet: print nothing but errors\n");
+  print_info("  -h              this help\n\n");
+  print_info("Exit status: 0 success, 1 bad arguments, 2 file error, 3 reconstruction failed.\n");
+}
+
+/// Collects the two file names and checks every option and its value.
+/// Numbers are read with PCL's parser, which rejects trailing garbage.
+bool parseArguments(int argc, char **argv, Options &options, std::string &error) {
+  const std::vector<std::string> value_options = {"-rho", "-fill_holes", "-threads"};
+  std::vector<std::string> positional;
+  for (int i = 1; i < argc; ++i) {
+    const std::string argument = argv[i];
+    if (argument == "-h" || argument == "--help") {
+      options.help = true;
+    } else if (argument == "-normals") {
+      options.normals = true;
+    } else if (argument == "-q") {
+      options.quiet = true;
+    } else if (std::find(value_options.begin(), value_options.end(), argument) !=
+               value_options.end()) {
+      if (i + 1 >= argc) {
+        error = argument + " needs a value";
+        return false;
+      }
+      ++i; // the value itself is parsed below
+    } else if (argument.size() > 1 && argument[0] == '-') {
+      error = "unknown option '" + argument + "' (see -h)";
+      return false;
+    } else {
+      positional.push_back(argument);
+    }
+  }
+  if (options.help)
+    return true;
+
+  const auto badValue = [&](const char *option) {
+    const int index = pcl::console::find_argument(argc, argv, option);
+    error = std::string(option) + ": '" + argv[index + 1] + "' is not a valid number";
+    return false;
+  };
+  if (pcl::console::find_argument(argc, argv, "-rho") >= 0 &&
+      pcl::console::parse_argument(argc, argv, "-rho", options.rho) < 0)
+    return badValue("-rho");
+  if (pcl::console::find_argument(argc, argv, "-fill_holes") >= 0 &&
+      pcl::console::parse_argument(argc, argv, "-fill_holes", options.fill_holes) < 0)
+    return badValue("-fill_holes");
+  if (pcl::console::find_argument(argc, argv, "-threads") >= 0 &&
+      pcl::console::parse_argument(argc, argv, "-threads", options.threads) < 0)
+    return badValue("-threads");
+
+  if (positional.size() != 2) {
+    error = "expected input and output file names, got " + std::to_string(positional.size()) +
+            " (see -h)";
+    return false;
+  }
+  options.input = positional[0];
+  options.output = positional[1];
+  return true;
+}
+
+/// PCL's readers, writers and the reconstruction class print their own
+/// diagnostics on stderr; we report the reason ourselves, in one line.
+class SilencePclMessages {
+public:
+  SilencePclMessages() : previous_(pcl::console::getVerbosityLevel()) {
+    pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
+  }
+  ~SilencePclMessages() { pcl::console::setVerbosityLevel(previous_); }
+  SilencePclMessages(const SilencePclMessages &) = delete;
+  SilencePclMessages &operator=(const SilencePclMessages &) = delete;
+
+private:
+  pcl::console::VERBOSITY_LEVEL previous_;
+};
+
+/// Converts the cloud to PointT, meshes it and returns the polygons, which
+/// index the cloud's points directly.
+template <typename PointT>
+bool reconstructAs(const pcl::PCLPointCloud2 &cloud, const pcl_ms::Parameters &parameters,
+                   std::vector<pcl::Vertices> &polygons, pcl_ms::Result &result,
+                   std::string &error) {
+  auto points = pcl::make_shared<pcl::PointCloud<PointT>>();
+  pcl::fromPCLPointCloud2(cloud, *points);
+  pcl::MedialScaffoldReconstruction<PointT> reconstruction;
+  reconstruction.setInputCloud(points);
+  reconstruction.setParameters(parameters);
+  pcl::PolygonMesh mesh;
+  {
+    SilencePclMessages silence;
+    reconstruction.reconstruct(mesh);
+  }
+  if (!reconstruction.getErrorMessage().empty()) {
+    error = "reconstruction failed: " + reconstruction.getErrorMessage();
+    return false;
+  }
+  polygons = std::move(mesh.polygons);
+  result = reconstruction.getResult();
+  return true;
+}
+
+std::string fieldNames(const pcl::PCLPointCloud2 &cloud) {
+  std::string names;
+  for (const pcl::PCLPointField &field : cloud.fields)
+    names += (names.empty() ? "" : " ") + field.name;
+  return names;
+}
+
+void printRow(const char *label, const char *format, double value) {
+  print_info("  %-22s", label);
+  print_value(format, value);
+  print_info("\n");
+}
+
+void printReport(const pcl_ms::Result &result, double load_ms, double save_ms) {
+  const pcl_ms::StageTimings &timings = result.timings;
+  print_info("\nTimings (ms):\n");
+  printRow("load", "%10.1f", load_ms);
+  printRow("prepare", "%10.1f", timings.prepare * 1e3);
+  printRow("delaunay", "%10.1f", timings.delaunay * 1e3);
+  printRow("scaffold", "%10.1f", timings.scaffold * 1e3);
+  printRow("greedy", "%10.1f", timings.greedy * 1e3);
+  printRow("finish", "%10.1f", timings.finish * 1e3);
+  printRow("total (reconstruction)", "%10.1f", timings.total * 1e3);
+  printRow("save", "%10.1f", save_ms);
+
+  print_info("\nSummary:\n");
+  printRow("input points", "%10.0f", static_cast<double>(result.input_points));
+  printRow("invalid points skipped", "%10.0f", static_cast<double>(result.invalid_points));
+  printRow("duplicates merged", "%10.0f", static_cast<double>(result.duplicate_points));
+  printRow("triangles", "%10.0f", static_cast<double>(result.triangles.size()));
+  printRow("boundary loops", "%10.0f", static_cast<double>(result.boundary_loops.size()));
+  print_info("  %-22s", "components");
+  print_value("%10zu", result.numberOfComponents());
+  print_info(" (");
+  print_value("%zu", result.numberOfNonOrientableComponents());
+  print_info(" non-orientable)\n");
+  printRow("d_med", "%10.6g", result.d_med);
+  printRow("d_max", "%10.6g", result.d_max);
+  if (result.planar)
+    print_info("  (all points lie on one plane: a 2-D Delaunay triangulation was used)\n");
+}
+
+int fail(ExitCode code, const std::string &reason) {
+  std::fflush(stdout);
+  std::fprintf(stderr, "error: %s\n", reason.c_str());
+  return code;
+}
+
+int run(int argc, char **argv) {
+  Options options;
+  std::string error;
+  if (!parseArguments(argc, argv, options, error))
+    return fail(kBadArguments, error);
+  if (options.help) {
+    printHelp(argv[0]);
+    return kSuccess;
+  }
+
+  pcl_ms::Parameters parameters;
+  parameters.rho = options.rho;
+  parameters.fill_holes_max_edges = options.fill_holes;
+  parameters.use_normals = options.normals;
+  parameters.num_threads = options.threads;
+  if (const std::string reason = parameters.validate(); !reason.empty())
+    return fail(kBadArguments, reason);
+
+  // Catch output problems before spending time on the reconstruction.
+  if (!pcl_ms::isMeshOutputSupported(options.output))
+    return fail(kBadArguments, options.output + ": output format '" +
+                                   pcl_ms::fileExtension(options.output) +
+                                   "' is not supported (use .ply, .vtk or .obj)");
+  const std::filesystem::path output_dir = std::filesystem::path(options.output).parent_path();
+  std::error_code code;
+  if (!output_dir.empty() && !std::filesystem::is_directory(output_dir, code))
+    return fail(kIoFailure,
+                options.output + ": directory " + output_dir.string() + " does not exist");
+
+  const bool verbose = !options.quiet;
+  pcl::console::TicToc timer;
+  if (verbose) {
+    print_highlight("Loading ");
+    print_value("%s ", options.input.c_str());
+  }
+  timer.tic();
+  pcl::PCLPointCloud2 cloud;
+  bool loaded = false;
+  {
+    SilencePclMessages silence;
+    loaded = pcl_ms::loadPointCloud(options.input, cloud, error);
+  }
+  const double load_ms = timer.toc();
+  if (!loaded) {
+    if (verbose)
+      print_info("[failed]\n");
+    return fail(kIoFailure, error);
+  }
+  if (verbose) {
+    print_info("[done, ");
+    print_value("%.1f", load_ms);
+    print_info(" ms : ");
+    print_value("%u", cloud.width * cloud.height);
+    print_info(" points]\n");
+    print_info("Available dimensions: ");
+    print_value("%s\n", fieldNames(cloud).c_str());
+  }
+  if (options.normals && !pcl_ms::hasNormals(cloud))
+    return fail(kBadArguments, "-normals was given but " + options.input +
+                                   " has no float normal_x, normal_y, normal_z fields");
+
+  if (verbose) {
+    print_highlight("Reconstructing with rho ");
+    print_value("%g", options.rho);
+    print_info(", fill holes ");
+    print_value("%d", options.fill_holes);
+    print_info(", normals ");
+    print_value("%s", options.normals ? "on" : "off");
+    print_info(", threads ");
+    print_value("%d ", options.threads);
+  }
+  timer.tic();
+  pcl::PolygonMesh mesh;
+  pcl_ms::Result result;
+  const bool reconstructed =
+      options.normals
+          ? reconstructAs<pcl::PointNormal>(cloud, parameters, mesh.polygons, result, error)
+          : reconstructAs<pcl::PointXYZ>(cloud, parameters, mesh.polygons, result, error);
+  const double reconstruct_ms = timer.toc();
+  if (!reconstructed) {
+    if (verbose)
+      print_info("[failed]\n");
+    return fail(kReconstructionFailure, error);
+  }
+  if (verbose) {
+    print_info("[done, ");
+    print_value("%.1f", reconstruct_ms);
+    print_info(" ms : ");
+    print_value("%zu", mesh.polygons.size());
+    print_info(" triangles]\n");
+  }
+
+  // The output keeps every field of the user's points, not just x, y, z.
+  mesh.header = cloud.header;
+  mesh.cloud = std::move(cloud);
+  if (verbose) {
+    print_highlight("Saving ");
+    print_value("%s ", options.output.c_str());
+  }
+  timer.tic();
+  bool saved = false;
+  {
+    SilencePclMessages silence;
+    saved = pcl_ms::saveMesh(options.output, mesh, error);
+  }
+  const double save_ms = timer.toc();
+  if (!saved) {
+    if (verbose)
+      print_info("[failed]\n");
+    return fail(kIoFailure, error);
+  }
+  if (verbose) {
+    print_info("[done, ");
+    print_value("%.1f", save_ms);
+    print_info(" ms]\n");
+    printReport(result, load_ms, save_ms);
+  }
+  return kSuccess;
+}
+
+} // namespace
+
+int main(int argc, char **argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception &exception) {
+    return fail(kReconstructionFailure, std::string("unexpected failure: ") + exception.what());
+  }
+}

@@ -1,0 +1,454 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// bench_reconstruct: times pcl_ms::reconstruct against CGAL's advancing-front
+// surface reconstruction (AFSR) and a bare 3-D Delaunay triangulation on the
+// bunny vertices and on uniform samplings of the bunny reference surface.
+// Every method runs single-threaded in its own forked child so that its peak
+// resident memory (ru_maxrss from wait4) is not mixed with the others'.
+#include <pcl_ms/io.h>
+#include <pcl_ms/reconstruct.h>
+
+#include <CGAL/Advancing_front_surface_reconstruction.h>
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+
+#include <sys/resource.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <exception>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using CgalPoint = Kernel::Point_3;
+
+/// What a child reports back through its pipe (plain bytes, fixed size).
+struct Measurement {
+  bool ok = false;
+  double seconds = 0;     // wall clock
+  double cpu_seconds = 0; // CPU time of the child: robust when the machine is busy
+  std::uint64_t triangles = 0;
+  pcl_ms::StageTimings stages; // pcl_ms only
+  char message[240] = {};
+};
+
+/// A finished run as the parent sees it.
+struct Run {
+  std::string method;
+  Measurement measurement;
+  double peak_mb = 0;
+};
+
+struct Input {
+  std::string name;
+  std::vector<float> xyz; // x, y, z per point
+  std::size_t size() const { return xyz.size() / 3; }
+};
+
+double processCpuSeconds() {
+  timespec time{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &time);
+  return static_cast<double>(time.tv_sec) + 1e-9 * static_cast<double>(time.tv_nsec);
+}
+
+/// Wall and CPU time of the measured call only (not of input conversion).
+class Stopwatch {
+public:
+  void stop(Measurement &measurement) const {
+    measurement.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
+    measurement.cpu_seconds = processCpuSeconds() - cpu_start_;
+  }
+
+private:
+  std::chrono::steady_clock::time_point wall_start_ = std::chrono::steady_clock::now();
+  double cpu_start_ = processCpuSeconds();
+};
+
+std::vector<CgalPoint> toCgalPoints(const Input &input) {
+  std::vector<CgalPoint> points;
+  points.reserve(input.size());
+  for (std::size_t i = 0; i < input.size(); ++i)
+    points.emplace_back(input.xyz[3 * i], input.xyz[3 * i + 1], input.xyz[3 * i + 2]);
+  return points;
+}
+
+// --- The measured methods. Each runs inside the child process. -------------
+
+Measurement runNothing(const Input &) {
+  Measurement measurement;
+  measurement.ok = true;
+  return measurement;
+}
+
+Measurement runPclMs(const Input &input) {
+  pcl_ms::PointView view;
+  view.xyz = input.xyz.data();
+  view.size = input.size();
+  pcl_ms::Parameters parameters;
+  parameters.num_threads = 1;
+  const Stopwatch stopwatch;
+  const pcl_ms::Result result = pcl_ms::reconstruct(view, parameters);
+  Measurement measurement;
+  stopwatch.stop(measurement);
+  measurement.triangles = result.triangles.size();
+  measurement.stages = result.timings;
+  measurement.ok = true;
+  return measurement;
+}
+
+Measurement runAfsr(const Input &input) {
+  // Point conversion is input preparation, not part of the timed work.
+  const std::vector<CgalPoint> points = toCgalPoints(input);
+  std::vector<std::array<std::size_t, 3>> facets;
+  const Stopwatch stopwatch;
+  CGAL::advancing_front_surface_reconstruction(points.begin(), points.end(),
+                                               std::back_inserter(facets));
+  Measurement measurement;
+  stopwatch.stop(measurement);
+  measurement.triangles = facets.size();
+  measurement.ok = true;
+  return measurement;
+}
+
+Measurement runDelaunay(const Input &input) {
+  const std::vector<CgalPoint> points = toCgalPoints(input);
+  const Stopwatch stopwatch;
+  CGAL::Delaunay_triangulation_3<Kernel> triangulation(points.begin(), points.end());
+  Measurement measurement;
+  stopwatch.stop(measurement);
+  measurement.triangles = triangulation.number_of_finite_facets();
+  measurement.ok = true;
+  return measurement;
+}
+
+/// Runs `method` in a forked child and collects its result and peak memory.
+Run runInChild(const std::string &name, const std::function<Measurement(const Input &)> &method,
+               const Input &input) {
+  Run run;
+  run.method = name;
+  std::fflush(stdout);
+  int channel[2];
+  if (pipe(channel) != 0) {
+    std::snprintf(run.measurement.message, sizeof(run.measurement.message), "pipe: %s",
+                  std::strerror(errno));
+    return run;
+  }
+  const pid_t child = fork();
+  if (child < 0) {
+    std::snprintf(run.measurement.message, sizeof(run.measurement.message), "fork: %s",
+                  std::strerror(errno));
+    close(channel[0]);
+    close(channel[1]);
+    return run;
+  }
+  if (child == 0) {
+    close(channel[0]);
+    Measurement measurement;
+    try {
+      measurement = method(input);
+    } catch (const std::exception &exception) {
+      measurement.ok = false;
+      std::snprintf(measurement.message, sizeof(measurement.message), "%s", exception.what());
+    }
+    const ssize_t written = write(channel[1], &measurement, sizeof(measurement));
+    _exit(written == static_cast<ssize_t>(sizeof(measurement)) ? 0 : 1);
+  }
+  close(channel[1]);
+  std::size_t received = 0;
+  auto *bytes = reinterpret_cast<char *>(&run.measurement);
+  while (received < sizeof(Measurement)) {
+    const ssize_t count = read(channel[0], bytes + received, sizeof(Measurement) - received);
+    if (count <= 0)
+      break;
+    received += static_cast<std::size_t>(count);
+  }
+  close(channel[0]);
+  int status = 0;
+  rusage usage{};
+  wait4(child, &status, 0, &usage);
+  run.peak_mb = static_cast<double>(usage.ru_maxrss) / 1024.0; // ru_maxrss is in KiB
+  if (received != sizeof(Measurement)) {
+    run.measurement = Measurement();
+    if (WIFSIGNALED(status))
+      std::snprintf(run.measurement.message, sizeof(run.measurement.message), "killed by signal %d",
+                    WTERMSIG(status));
+    else
+      std::snprintf(run.measurement.message, sizeof(run.measurement.message),
+                    "exited with status %d", WEXITSTATUS(status));
+  }
+  return run;
+}
+
+// --- Inputs -----------------------------------------------------------------
+
+bool loadBunnyVertices(const std::string &path, Input &input, std::string &error) {
+  pcl::PCLPointCloud2 cloud;
+  if (!pcl_ms::loadPointCloud(path, cloud, error))
+    return false;
+  const std::size_t count = static_cast<std::size_t>(cloud.width) * cloud.height;
+  int x = -1;
+  for (std::size_t f = 0; f < cloud.fields.size(); ++f)
+    if (cloud.fields[f].name == "x")
+      x = static_cast<int>(f);
+  input.name = "bunny vertices (" + path + ")";
+  input.xyz.resize(3 * count);
+  // loadPointCloud guarantees float32 x, y, z; PCL stores them consecutively.
+  for (std::size_t i = 0; i < count; ++i)
+    std::memcpy(&input.xyz[3 * i], &cloud.data[i * cloud.point_step + cloud.fields[x].offset],
+                3 * sizeof(float));
+  return true;
+}
+
+/// Uniform samples of the surface: triangles drawn in proportion to their
+/// area, points uniform inside them. The seed depends only on the size so a
+/// size gives the same points whichever other sizes are run.
+Input sampleSurface(const std::vector<Eigen::Vector3d> &vertices,
+                    const std::vector<pcl_ms::Triangle> &triangles, std::size_t size) {
+  std::vector<double> cumulative_area(triangles.size());
+  double total = 0;
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const Eigen::Vector3d &a = vertices[triangles[t][0]];
+    total += 0.5 * (vertices[triangles[t][1]] - a).cross(vertices[triangles[t][2]] - a).norm();
+    cumulative_area[t] = total;
+  }
+  std::mt19937 random(20240521u + static_cast<std::uint32_t>(size));
+  std::uniform_real_distribution<double> area(0.0, total), unit(0.0, 1.0);
+  Input input;
+  input.name = "bun_zipper surface sample, seed " + std::to_string(20240521u + size);
+  input.xyz.reserve(3 * size);
+  for (std::size_t i = 0; i < size; ++i) {
+    const auto chosen =
+        std::upper_bound(cumulative_area.begin(), cumulative_area.end(), area(random)) -
+        cumulative_area.begin();
+    const pcl_ms::Triangle &triangle =
+        triangles[std::min<std::size_t>(static_cast<std::size_t>(chosen), triangles.size() - 1)];
+    double u = unit(random), v = unit(random);
+    if (u + v > 1) { // fold the far half of the square back onto the triangle
+      u = 1 - u;
+      v = 1 - v;
+    }
+    const Eigen::Vector3d &a = vertices[triangle[0]];
+    const Eigen::Vector3d point =
+        a + u * (vertices[triangle[1]] - a) + v * (vertices[triangle[2]] - a);
+    for (int k = 0; k < 3; ++k)
+      input.xyz.push_back(static_cast<float>(point[k]));
+  }
+  return input;
+}
+
+// --- Output -----------------------------------------------------------------
+
+std::string withThousands(std::uint64_t value) {
+  std::string digits = std::to_string(value), out;
+  for (std::size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0)
+      out += ',';
+    out += digits[i];
+  }
+  return out;
+}
+
+const Run *findRun(const std::vector<Run> &runs, const std::string &method) {
+  for (const Run &run : runs)
+    if (run.method == method && run.measurement.ok)
+      return &run;
+  return nullptr;
+}
+
+void printRatio(const std::vector<Run> &runs, const std::string &other, double baseline_mb) {
+  const Run *ours = findRun(runs, "pcl_ms");
+  const Run *theirs = findRun(runs, other);
+  if (!ours || !theirs)
+    return;
+  const double our_extra = ours->peak_mb - baseline_mb;
+  const double their_extra = theirs->peak_mb - baseline_mb;
+  const auto ratio = [](double a, double b) { return a / std::max(b, 1e-9); };
+  std::printf("  pcl_ms / %-12s time %6.2fx (cpu %5.2fx)   peak memory %5.2fx", other.c_str(),
+              ratio(ours->measurement.seconds, theirs->measurement.seconds),
+              ratio(ours->measurement.cpu_seconds, theirs->measurement.cpu_seconds),
+              ratio(ours->peak_mb, theirs->peak_mb));
+  if (their_extra > 0.5)
+    std::printf("   above input %5.2fx", our_extra / their_extra);
+  std::printf("\n");
+}
+
+void printTable(const Input &input, const std::vector<Run> &runs, double baseline_mb) {
+  std::printf("\n== %s: %s points ==\n", input.name.c_str(), withThousands(input.size()).c_str());
+  std::printf("  %-14s %10s %10s %11s %12s %12s\n", "method", "time [s]", "cpu [s]", "peak [MB]",
+              "above input", "triangles");
+  for (const Run &run : runs) {
+    if (!run.measurement.ok) {
+      std::printf("  %-14s failed: %s\n", run.method.c_str(), run.measurement.message);
+      continue;
+    }
+    if (run.method == "input only") {
+      std::printf("  %-14s %10s %10s %11.1f %12s %12s\n", run.method.c_str(), "-", "-", run.peak_mb,
+                  "-", "-");
+      continue;
+    }
+    std::printf("  %-14s %10.3f %10.3f %11.1f %12.1f %12s%s\n", run.method.c_str(),
+                run.measurement.seconds, run.measurement.cpu_seconds, run.peak_mb,
+                run.peak_mb - baseline_mb, withThousands(run.measurement.triangles).c_str(),
+                run.method == "Delaunay 3D" ? " (all facets)" : "");
+  }
+  if (const Run *ours = findRun(runs, "pcl_ms")) {
+    const pcl_ms::StageTimings &stages = ours->measurement.stages;
+    std::printf("  pcl_ms stages [s]: prepare %.3f  delaunay %.3f  scaffold %.3f  greedy %.3f  "
+                "finish %.3f  total %.3f\n",
+                stages.prepare, stages.delaunay, stages.scaffold, stages.greedy, stages.finish,
+                stages.total);
+  }
+  printRatio(runs, "AFSR", baseline_mb);
+  printRatio(runs, "Delaunay 3D", baseline_mb);
+  std::fflush(stdout);
+}
+
+void writeCsvRows(std::ofstream &csv, const Input &input, const std::vector<Run> &runs,
+                  double baseline_mb) {
+  for (const Run &run : runs) {
+    const Measurement &m = run.measurement;
+    const bool ours = run.method == "pcl_ms";
+    csv << '"' << input.name << "\"," << input.size() << ',' << run.method << ','
+        << (m.ok ? "ok" : "failed") << ',' << m.seconds << ',' << m.cpu_seconds << ','
+        << run.peak_mb << ',' << run.peak_mb - baseline_mb << ',' << m.triangles;
+    if (ours)
+      csv << ',' << m.stages.prepare << ',' << m.stages.delaunay << ',' << m.stages.scaffold << ','
+          << m.stages.greedy << ',' << m.stages.finish << ',' << m.stages.total;
+    else
+      csv << ",,,,,,";
+    csv << '\n';
+  }
+  csv.flush();
+}
+
+// --- Command line -------------------------------------------------------------
+
+void printHelp(const char *program) {
+  std::printf("Times pcl_ms::reconstruct, CGAL's advancing-front reconstruction (AFSR) and a bare\n"
+              "CGAL 3-D Delaunay triangulation, single-threaded, each in its own child process.\n\n"
+              "Usage: %s [options]\n\n"
+              "  -data DIR        sample data directory with bunny.pcd (default: data)\n"
+              "  -mesh PATH       reference mesh to sample (default: DIR/bun_zipper.ply)\n"
+              "  -sizes N,N,...   surface sample sizes, or none (default: 100000,300000,1000000)\n"
+              "  -skip_afsr       do not run AFSR (slow on large inputs)\n"
+              "  -csv FILE        also write every measurement to FILE\n"
+              "  -h               this help\n",
+              program);
+}
+
+bool parseSizes(const std::string &text, std::vector<std::size_t> &sizes) {
+  sizes.clear();
+  if (text == "none")
+    return true;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    std::size_t end = text.find(',', start);
+    if (end == std::string::npos)
+      end = text.size();
+    std::size_t value = 0;
+    const auto [last, code] = std::from_chars(text.data() + start, text.data() + end, value);
+    if (code != std::errc() || last != text.data() + end || value < 4)
+      return false;
+    sizes.push_back(value);
+    start = end + 1;
+  }
+  return true;
+}
+
+int fail(const std::string &reason) {
+  std::fflush(stdout);
+  std::fprintf(stderr, "error: %s\n", reason.c_str());
+  return 1;
+}
+
+} // namespace
+
+int main(int argc, char **argv) {
+  if (pcl::console::find_switch(argc, argv, "-h") ||
+      pcl::console::find_switch(argc, argv, "--help")) {
+    printHelp(argv[0]);
+    return 0;
+  }
+  for (int i = 1; i < argc; ++i) {
+    const std::string argument = argv[i];
+    if (argument == "-data" || argument == "-mesh" || argument == "-sizes" || argument == "-csv") {
+      if (++i >= argc)
+        return fail(argument + " needs a value");
+    } else if (argument != "-skip_afsr") {
+      return fail("unknown argument '" + argument + "' (see -h)");
+    }
+  }
+  std::string data_dir = "data", mesh_path, sizes_text = "100000,300000,1000000", csv_path;
+  pcl::console::parse_argument(argc, argv, "-data", data_dir);
+  mesh_path = data_dir + "/bun_zipper.ply";
+  pcl::console::parse_argument(argc, argv, "-mesh", mesh_path);
+  pcl::console::parse_argument(argc, argv, "-sizes", sizes_text);
+  pcl::console::parse_argument(argc, argv, "-csv", csv_path);
+  const bool skip_afsr = pcl::console::find_switch(argc, argv, "-skip_afsr");
+  std::vector<std::size_t> sizes;
+  if (!parseSizes(sizes_text, sizes))
+    return fail("-sizes: expected 'none' or a comma-separated list of numbers >= 4, got '" +
+                sizes_text + "'");
+
+  std::ofstream csv;
+  if (!csv_path.empty()) {
+    csv.open(csv_path);
+    if (!csv)
+      return fail("cannot write " + csv_path);
+    csv << "input,points,method,status,time_s,cpu_s,peak_mb,above_input_mb,triangles,"
+           "prepare_s,delaunay_s,scaffold_s,greedy_s,finish_s,total_s\n";
+  }
+
+  // PCL's readers explain failures on stderr themselves; we print one line.
+  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
+  std::string error;
+  Input bunny;
+  if (!loadBunnyVertices(data_dir + "/bunny.pcd", bunny, error))
+    return fail(error);
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<pcl_ms::Triangle> triangles;
+  if (!sizes.empty() && !pcl_ms::loadMesh(mesh_path, vertices, triangles, error))
+    return fail(error);
+
+  std::printf("bench_reconstruct: single-threaded; each method in a forked child, peak = its "
+              "ru_maxrss.\n'above input' subtracts the peak of a child that only holds the "
+              "input. pcl_ms::Result has no per-stage memory, so only peaks are shown.\n");
+  for (std::size_t i = 0; i <= sizes.size(); ++i) {
+    // Sample each size only when its turn comes, so the parent stays small.
+    Input sampled;
+    if (i > 0)
+      sampled = sampleSurface(vertices, triangles, sizes[i - 1]);
+    const Input &input = i == 0 ? bunny : sampled;
+
+    std::vector<Run> runs;
+    runs.push_back(runInChild("input only", runNothing, input));
+    const double baseline_mb = runs.back().peak_mb;
+    runs.push_back(runInChild("pcl_ms", runPclMs, input));
+    if (!skip_afsr)
+      runs.push_back(runInChild("AFSR", runAfsr, input));
+    runs.push_back(runInChild("Delaunay 3D", runDelaunay, input));
+    printTable(input, runs, baseline_mb);
+    if (csv.is_open())
+      writeCsvRows(csv, input, runs, baseline_mb);
+  }
+  return 0;
+}

@@ -1,0 +1,50 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Stage 4: greedy gap transforms (paper §3, ALGORITHM.md §2-4). Candidates
+// are accepted cheapest first under 2-manifold rules; accepted neighbours
+// change the costs; conflicts undo costlier earlier choices.
+#pragma once
+
+#include <pcl_ms/mesh_topology.h>
+#include <pcl_ms/scaffold.h>
+#include <pcl_ms/types.h>
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <vector>
+
+namespace pcl_ms {
+
+struct GreedyStatistics {
+  PassStatistics pass1, pass2;
+  /// Flaps and isolated triangles undone between the passes, plus triangles
+  /// undone by the final manifold sweep.
+  std::size_t cleanup_undone = 0;
+  /// Pairs of triangles replaced by the other diagonal's pair.
+  std::size_t swapped_pairs = 0;
+};
+
+class GreedyMesher {
+public:
+  GreedyMesher(const MedialScaffold &scaffold, const std::vector<Eigen::Vector3d> &points,
+               const Parameters &parameters);
+  ~GreedyMesher();
+  GreedyMesher(const GreedyMesher &) = delete;
+  GreedyMesher &operator=(const GreedyMesher &) = delete;
+
+  /// Pass 1 (types I, II), clean-up, pass 2 (type III and demoted), then
+  /// the final sweep that guarantees a 2-manifold result.
+  void run();
+
+  /// Accepted triangles as distinct-point indices, in candidate order.
+  std::vector<Triangle> triangles() const;
+  const GreedyStatistics &statistics() const { return statistics_; }
+  const MeshTopology &mesh() const;
+
+private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+  GreedyStatistics statistics_;
+};
+
+} // namespace pcl_ms

@@ -1,0 +1,80 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Stage 1: the medial scaffold of a point cloud, read off its Delaunay
+// tetrahedralisation. Every Delaunay triangle is dual to a Voronoi edge (an
+// A1^3 shock curve) and is a candidate surface triangle.
+#pragma once
+
+#include <pcl_ms/types.h>
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace pcl_ms {
+
+using CandidateIndex = std::uint32_t;
+using EdgeIndex = std::uint32_t;
+
+/// Fig. 10 of the paper: where the shock curve's A1^3-2 point (the triangle's
+/// circumcentre) lies.
+enum class CandidateType : std::uint8_t {
+  acute = 1,    // type I: on the Voronoi edge, inside the triangle
+  obtuse = 2,   // type II: on the Voronoi edge, right or obtuse triangle
+  ambiguous = 3 // type III: off the Voronoi edge (the triangle is not Gabriel)
+};
+
+struct Candidate {
+  /// Distinct-point indices, ascending.
+  std::array<VertexIndex, 3> vertices;
+  /// edges[k] joins vertices[k] and vertices[(k + 1) % 3].
+  std::array<EdgeIndex, 3> edges;
+  /// eps1 = P / (R C^2), scaled by the normal term when normals are used.
+  float base_cost;
+  /// 1 / (R C^2), the factor of the context cost eps2.
+  float inverse_shock_compactness;
+  CandidateType type;
+};
+
+/// Candidates below d_max, and which candidates share each edge (CSR).
+struct MedialScaffold {
+  std::vector<Candidate> candidates;
+  std::vector<std::uint32_t> edge_offsets; // edges + 1 entries
+  std::vector<CandidateIndex> edge_candidates;
+
+  double d_med = 0; // median circumradius of type I and II triangles
+  double d_max = 0; // rho * d_med
+  bool planar = false;
+  std::size_t type1 = 0, type2 = 0, type3 = 0;
+  std::size_t oversize = 0;   // longest side >= d_max: never queued
+  std::size_t degenerate = 0; // collinear generators: never queued
+  double delaunay_seconds = 0;
+
+  std::size_t numberOfEdges() const { return edge_offsets.empty() ? 0 : edge_offsets.size() - 1; }
+  /// Candidates on edge e, as a [begin, end) pointer range.
+  const CandidateIndex *edgeBegin(EdgeIndex e) const {
+    return edge_candidates.data() + edge_offsets[e];
+  }
+  const CandidateIndex *edgeEnd(EdgeIndex e) const {
+    return edge_candidates.data() + edge_offsets[e + 1];
+  }
+};
+
+struct ScaffoldOptions {
+  double rho = 10.0;
+  int num_threads = 1;
+  /// Optional unit normals per point (same indexing as points) and kappa.
+  const std::vector<Eigen::Vector3f> *normals = nullptr;
+  double normal_weight = 1.0;
+};
+
+/// Builds the scaffold of distinct points (at least 3, not all collinear:
+/// callers check). Points are expected near the origin (callers centre them)
+/// so that floating-point circumcentres stay accurate. Throws
+/// ReconstructionError for collinear input. The Delaunay structure is freed
+/// before returning: memory afterwards is about the candidates.
+MedialScaffold buildMedialScaffold(const std::vector<Eigen::Vector3d> &points,
+                                   const ScaffoldOptions &options);
+
+} // namespace pcl_ms

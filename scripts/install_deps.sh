@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
+#
+# Installs the Debian (bookworm) packages pcl_ms needs to build and test.
+# Does nothing, quickly, when they are all installed already. Installing
+# needs root; as another user it lists what is missing and exits 1.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential
+  cmake
+  pkg-config
+  libpcl-dev
+  libcgal-dev
+  libeigen3-dev
+  libflann-dev
+  libboost-dev
+  libgtest-dev
+  libtbb-dev
+  libgmp-dev
+  libmpfr-dev
+)
+
+missing=()
+for package in "${PACKAGES[@]}"; do
+  status="$(dpkg-query -W -f='${db:Status-Status}' "${package}" 2>/dev/null || true)"
+  if [[ "${status}" != "installed" ]]; then
+    missing+=("${package}")
+  fi
+done
+
+if [[ ${#missing[@]} -eq 0 ]]; then
+  echo "install_deps: all ${#PACKAGES[@]} required packages are installed"
+  exit 0
+fi
+
+echo "install_deps: missing packages: ${missing[*]}"
+if [[ "$(id -u)" -ne 0 ]]; then
+  echo "install_deps: not running as root, cannot install them." >&2
+  echo "install_deps: run this script as root, or install them yourself:" >&2
+  echo "  sudo apt-get update && sudo apt-get install -y --no-install-recommends ${missing[*]}" >&2
+  exit 1
+fi
+
+export DEBIAN_FRONTEND=noninteractive
+apt-get update
+apt-get install -y --no-install-recommends "${missing[@]}"
+echo "install_deps: installed ${missing[*]}"

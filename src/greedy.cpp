@@ -1,0 +1,555 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <pcl_ms/costs.h>
+#include <pcl_ms/greedy.h>
+
+#include <boost/heap/d_ary_heap.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace pcl_ms {
+namespace {
+
+enum class State : std::uint8_t { idle, queue1, queue2, accepted, dropped };
+
+struct QueueEntry {
+  float cost;
+  CandidateIndex candidate;
+};
+
+// Boost's heaps keep the greatest element on top: "greater" puts the
+// cheapest first, and the candidate index breaks ties so the order is total.
+struct CheaperFirst {
+  bool operator()(const QueueEntry &a, const QueueEntry &b) const {
+    return a.cost > b.cost || (a.cost == b.cost && a.candidate > b.candidate);
+  }
+};
+
+using Queue = boost::heap::d_ary_heap<QueueEntry, boost::heap::arity<4>, boost::heap::mutable_<true>,
+                                      boost::heap::compare<CheaperFirst>>;
+
+// An undone triangle is re-queued at most this often, so that two candidates
+// whose costs keep crossing cannot undo each other forever.
+constexpr std::uint8_t max_undos = 3;
+
+// A swap must improve the angle sum by more than rounding noise, or
+// co-circular quads would flip back and forth.
+constexpr double swap_angle_tolerance = 1e-9;
+
+// Swaps may bend a quad up to this much (20 degrees) even when it was flatter
+// before: smooth surfaces bend a little either way.
+constexpr double smooth_bending_angle = 0.35;
+
+} // namespace
+
+class GreedyMesher::Impl {
+public:
+  Impl(const MedialScaffold &scaffold, const std::vector<Eigen::Vector3d> &points,
+       const Parameters &parameters, GreedyStatistics &statistics)
+      : scaffold_(scaffold), candidates_(scaffold.candidates), points_(points),
+        parameters_(parameters), statistics_(statistics),
+        mesh_(scaffold, points.size()), context_(candidates_.size(), 0.0),
+        cost_(candidates_.size(), 0.f), state_(candidates_.size(), State::idle),
+        incidence_delays_(candidates_.size(), 0), ranking_delays_(candidates_.size(), 0),
+        undos_(candidates_.size(), 0), handles_(candidates_.size()),
+        multi_fan_vertex_(points.size(), false) {
+    delay_multiplier_.resize(2 * static_cast<std::size_t>(parameters.max_delays) + 1);
+    for (std::size_t k = 0; k < delay_multiplier_.size(); ++k)
+      delay_multiplier_[k] = std::pow(parameters.delay_factor, static_cast<double>(k));
+  }
+
+  void run() {
+    for (CandidateIndex t = 0; t < candidates_.size(); ++t) {
+      cost_[t] = static_cast<float>(freshCost(t));
+      push(t, candidates_[t].type == CandidateType::ambiguous ? State::queue2 : State::queue1);
+    }
+    runPass(State::queue1, statistics_.pass1);
+    removeFlapsAndIsolatedTriangles();
+    buildQueue2(statistics_.pass2);
+    runPass(State::queue2, statistics_.pass2);
+    swapNonDelaunayDiagonals();
+    enforceManifoldVertices();
+  }
+
+  const MeshTopology &mesh() const { return mesh_; }
+
+  std::vector<Triangle> triangles() const {
+    std::vector<Triangle> result;
+    result.reserve(mesh_.size());
+    for (CandidateIndex t = 0; t < candidates_.size(); ++t)
+      if (mesh_.contains(t))
+        result.push_back(candidates_[t].vertices);
+    return result;
+  }
+
+private:
+  // ---- costs -------------------------------------------------------------
+
+  double freshCost(CandidateIndex t) const {
+    const double undelayed = std::max(0.0, candidates_[t].base_cost + context_[t]);
+    return undelayed * delay_multiplier_[incidence_delays_[t] + ranking_delays_[t]];
+  }
+
+  /// eps2 that accepted triangle `from` adds to candidate `to` across edge
+  /// slot k of `from`.
+  double contextTerm(CandidateIndex from, int k, CandidateIndex to) const {
+    const Candidate &source = candidates_[from];
+    const Candidate &target = candidates_[to];
+    const VertexIndex p = source.vertices[k], q = source.vertices[(k + 1) % 3];
+    const VertexIndex source_apex = source.vertices[(k + 2) % 3];
+    VertexIndex target_apex = target.vertices[0];
+    for (VertexIndex v : target.vertices)
+      if (v != p && v != q)
+        target_apex = v;
+    const double edge_length = (points_[q] - points_[p]).norm();
+    const double angle =
+        bendingAngle(points_[p], points_[q], points_[source_apex], points_[target_apex]);
+    return contextCost(edge_length, target.inverse_shock_compactness, angle);
+  }
+
+  /// Adds (sign +1) or removes (sign -1) accepted triangle t's context from
+  /// every candidate sharing one of its edges, accepted ones included: their
+  /// current cost is what error recovery compares against.
+  void propagateContext(CandidateIndex t, double sign) {
+    const Candidate &candidate = candidates_[t];
+    for (int k = 0; k < 3; ++k) {
+      const EdgeIndex e = candidate.edges[k];
+      for (const CandidateIndex *s = scaffold_.edgeBegin(e); s != scaffold_.edgeEnd(e); ++s) {
+        // Dropped candidates never return; waiting Q2 members get their
+        // context recomputed when Q2 is built.
+        if (*s == t || state_[*s] == State::dropped || isWaitingForQueue2(*s))
+          continue;
+        context_[*s] += sign * contextTerm(t, k, *s);
+        refreshCost(*s);
+      }
+    }
+  }
+
+  /// Context of t from scratch: the sum over accepted triangles on its edges.
+  double contextFromScratch(CandidateIndex t) const {
+    double context = 0;
+    for (EdgeIndex e : candidates_[t].edges)
+      for (CandidateIndex u : mesh_.edgeTriangles(e)) {
+        if (u == no_candidate || u == t)
+          continue;
+        for (int k = 0; k < 3; ++k)
+          if (candidates_[u].edges[k] == e)
+            context += contextTerm(u, k, t);
+      }
+    return context;
+  }
+
+  void refreshCost(CandidateIndex t) {
+    cost_[t] = static_cast<float>(freshCost(t));
+    if (isQueued(t) && !isWaitingForQueue2(t))
+      queueOf(state_[t]).update(handles_[t], QueueEntry{cost_[t], t});
+  }
+
+  // ---- queues ------------------------------------------------------------
+
+  bool isWaitingForQueue2(CandidateIndex t) const {
+    return !queue2_built_ && state_[t] == State::queue2;
+  }
+
+  bool isQueued(CandidateIndex t) const {
+    return state_[t] == State::queue1 || state_[t] == State::queue2;
+  }
+  Queue &queueOf(State state) { return state == State::queue1 ? queue1_ : queue2_; }
+
+  void push(CandidateIndex t, State queue) {
+    state_[t] = queue;
+    if (queue == State::queue2 && !queue2_built_)
+      return; // queued when pass 2 starts
+    handles_[t] = queueOf(queue).push(QueueEntry{cost_[t], t});
+  }
+
+  /// Q2 waits through pass 1 untouched (most of it is type III far from the
+  /// surface); its context is computed once, here, from the accepted mesh.
+  /// The closed-vertex rule is applied now rather than at each pop: after
+  /// pass 1 most type III candidates touch a closed vertex.
+  void buildQueue2(PassStatistics &statistics) {
+    queue2_built_ = true;
+    for (CandidateIndex t = 0; t < candidates_.size(); ++t) {
+      if (state_[t] != State::queue2)
+        continue;
+      if (touchesClosedVertex(t)) {
+        state_[t] = State::dropped;
+        ++statistics.rejected;
+        continue;
+      }
+      context_[t] = contextFromScratch(t);
+      cost_[t] = static_cast<float>(freshCost(t));
+      handles_[t] = queue2_.push(QueueEntry{cost_[t], t});
+    }
+  }
+
+  void runPass(State queue_state, PassStatistics &statistics) {
+    Queue &queue = queueOf(queue_state);
+    while (!queue.empty()) {
+      const CandidateIndex t = queue.top().candidate;
+      queue.pop();
+      state_[t] = State::idle;
+      ++statistics.popped;
+      decide(t, queue_state, statistics);
+    }
+  }
+
+  // ---- decisions ---------------------------------------------------------
+
+  bool touchesClosedVertex(CandidateIndex t) const {
+    for (VertexIndex v : candidates_[t].vertices)
+      if (mesh_.isClosedVertex(v))
+        return true;
+    return false;
+  }
+
+  bool hasFullEdge(CandidateIndex t) const {
+    for (EdgeIndex e : candidates_[t].edges)
+      if (mesh_.edgeTriangleCount(e) >= 2)
+        return true;
+    return false;
+  }
+
+  /// Error recovery: on each full edge of t, undo the accepted triangles that
+  /// have become costlier than t.
+  void undoCostlierOnFullEdges(CandidateIndex t, PassStatistics &statistics) {
+    for (EdgeIndex e : candidates_[t].edges) {
+      if (mesh_.edgeTriangleCount(e) < 2)
+        continue;
+      const auto occupants = mesh_.edgeTriangles(e);
+      for (CandidateIndex u : occupants)
+        if (u != no_candidate && cost_[u] > cost_[t]) {
+          undo(u);
+          ++statistics.undone;
+        }
+    }
+  }
+
+  void decide(CandidateIndex t, State from, PassStatistics &statistics) {
+    // 1. Edge rule: at most two triangles per edge.
+    if (hasFullEdge(t)) {
+      if (parameters_.error_recovery)
+        undoCostlierOnFullEdges(t, statistics);
+      if (hasFullEdge(t)) {
+        if (from == State::queue1) {
+          push(t, State::queue2);
+          ++statistics.demoted;
+        } else {
+          state_[t] = State::dropped;
+          ++statistics.rejected;
+        }
+        return;
+      }
+    }
+    // 2. Vertex rules.
+    if (touchesClosedVertex(t)) {
+      state_[t] = State::dropped;
+      ++statistics.rejected;
+      return;
+    }
+    bool vertex_face_incidence = false;
+    for (VertexIndex v : candidates_[t].vertices) {
+      if (!mesh_.vertexTriangles(v).empty()) {
+        const auto edges = mesh_.edgesAt(t, v);
+        if (mesh_.edgeTriangleCount(edges[0]) == 0 && mesh_.edgeTriangleCount(edges[1]) == 0)
+          vertex_face_incidence = true;
+      }
+    }
+    if (vertex_face_incidence && incidence_delays_[t] < parameters_.max_delays) {
+      ++incidence_delays_[t];
+      delay(t, from, statistics);
+      return;
+    }
+    // 3. Close-ranking delay: wait for context when a competitor is as cheap.
+    if (closeCompetitorDelayed(t, from)) {
+      delay(t, from, statistics);
+      return;
+    }
+    accept(t, vertex_face_incidence);
+    ++statistics.accepted;
+  }
+
+  void delay(CandidateIndex t, State from, PassStatistics &statistics) {
+    cost_[t] = static_cast<float>(freshCost(t));
+    push(t, from);
+    ++statistics.delayed;
+  }
+
+  /// A competitor is a candidate of the same queue on an edge of t that can
+  /// take only one more triangle. If one is within the tolerance, both are
+  /// delayed. (Q2 members are not decided in pass 1, so they do not compete.)
+  bool closeCompetitorDelayed(CandidateIndex t, State queue) {
+    if (parameters_.close_ranking_tolerance <= 0 || ranking_delays_[t] >= parameters_.max_delays)
+      return false;
+    const double tolerance = parameters_.close_ranking_tolerance * cost_[t];
+    for (EdgeIndex e : candidates_[t].edges) {
+      if (mesh_.edgeTriangleCount(e) != 1)
+        continue;
+      for (const CandidateIndex *s = scaffold_.edgeBegin(e); s != scaffold_.edgeEnd(e); ++s) {
+        if (*s == t || state_[*s] != queue || ranking_delays_[*s] >= parameters_.max_delays)
+          continue;
+        if (std::abs(cost_[*s] - cost_[t]) <= tolerance) {
+          ++ranking_delays_[*s];
+          refreshCost(*s);
+          ++ranking_delays_[t];
+          return true;
+        }
+      }
+    }
+    return false;
+  }
+
+  void accept(CandidateIndex t, bool created_second_fan) {
+    mesh_.add(t);
+    state_[t] = State::accepted;
+    propagateContext(t, +1.0);
+    for (VertexIndex v : candidates_[t].vertices) {
+      if (created_second_fan && mesh_.edgeTriangleCount(mesh_.edgesAt(t, v)[0]) == 1 &&
+          mesh_.edgeTriangleCount(mesh_.edgesAt(t, v)[1]) == 1 &&
+          mesh_.vertexTriangles(v).size() > 1)
+        multi_fan_vertex_[v] = true;
+      if (multi_fan_vertex_[v])
+        keepClosedFanOnly(v);
+    }
+  }
+
+  /// A vertex whose triangles form a closed ring plus other fans: the ring
+  /// wins and the extras are undone.
+  void keepClosedFanOnly(VertexIndex v) {
+    const auto fans = mesh_.fansAround(v);
+    if (fans.size() <= 1) {
+      multi_fan_vertex_[v] = false;
+      return;
+    }
+    const std::vector<CandidateIndex> *closed = nullptr;
+    for (const auto &fan : fans)
+      if (isClosedFan(fan, v))
+        closed = &fan;
+    if (!closed)
+      return;
+    for (const auto &fan : fans)
+      if (&fan != closed)
+        for (CandidateIndex u : fan)
+          undo(u);
+    multi_fan_vertex_[v] = false;
+  }
+
+  bool isClosedFan(const std::vector<CandidateIndex> &fan, VertexIndex v) const {
+    for (CandidateIndex u : fan)
+      for (EdgeIndex e : mesh_.edgesAt(u, v))
+        if (mesh_.edgeTriangleCount(e) != 2)
+          return false;
+    return true;
+  }
+
+  /// Takes t out of the mesh and sends it to Q2 with a fresh cost.
+  void undo(CandidateIndex t) {
+    mesh_.remove(t);
+    propagateContext(t, -1.0);
+    cost_[t] = static_cast<float>(freshCost(t));
+    if (++undos_[t] > max_undos) {
+      state_[t] = State::dropped;
+      return;
+    }
+    push(t, State::queue2);
+  }
+
+  // ---- diagonal swaps -------------------------------------------------------
+
+  /// The edge of candidate t joining a and b (both vertices of t).
+  EdgeIndex edgeBetween(CandidateIndex t, VertexIndex a, VertexIndex b) const {
+    const Candidate &candidate = candidates_[t];
+    for (int k = 0; k < 3; ++k) {
+      const VertexIndex p = candidate.vertices[k], q = candidate.vertices[(k + 1) % 3];
+      if ((p == a && q == b) || (p == b && q == a))
+        return candidate.edges[k];
+    }
+    return candidate.edges[0];
+  }
+
+  /// The candidate on edge e whose third vertex is apex, or no_candidate.
+  CandidateIndex candidateWith(EdgeIndex e, VertexIndex apex) const {
+    for (const CandidateIndex *s = scaffold_.edgeBegin(e); s != scaffold_.edgeEnd(e); ++s) {
+      const auto &v = candidates_[*s].vertices;
+      if (v[0] == apex || v[1] == apex || v[2] == apex)
+        return *s;
+    }
+    return no_candidate;
+  }
+
+  VertexIndex apexOf(CandidateIndex t, VertexIndex a, VertexIndex c) const {
+    for (VertexIndex v : candidates_[t].vertices)
+      if (v != a && v != c)
+        return v;
+    return a;
+  }
+
+  double angleAt(VertexIndex apex, VertexIndex a, VertexIndex c) const {
+    const Eigen::Vector3d u = points_[a] - points_[apex], w = points_[c] - points_[apex];
+    return std::atan2(u.cross(w).norm(), u.dot(w));
+  }
+
+  /// Error recovery after the passes: two accepted triangles (a, c, b) and
+  /// (a, c, d) whose quad is not locally Delaunay on the surface (the angles
+  /// at b and d sum to more than pi) are replaced by the other pair of
+  /// Delaunay candidates (a, b, d), (b, c, d), when that pair exists, its
+  /// diagonal is not a mesh edge yet and it bends the surface no more (so
+  /// ridges stay). On curved surfaces the 3-D empty-sphere test alone often
+  /// picks the diagonal a surface triangulation would not.
+  void swapNonDelaunayDiagonals() {
+    std::vector<EdgeIndex> work;
+    std::vector<bool> queued(scaffold_.numberOfEdges(), false);
+    auto enqueue = [&](EdgeIndex e) {
+      if (!queued[e] && mesh_.edgeTriangleCount(e) == 2) {
+        queued[e] = true;
+        work.push_back(e);
+      }
+    };
+    for (CandidateIndex t = 0; t < candidates_.size(); ++t)
+      if (mesh_.contains(t))
+        for (EdgeIndex e : candidates_[t].edges)
+          enqueue(e);
+    // Flips on a curved surface change its geometry, so unlike in the plane
+    // termination is not guaranteed: bound the work.
+    std::size_t budget = 4 * work.size() + 16;
+    for (std::size_t head = 0; head < work.size() && budget > 0; ++head, --budget) {
+      const EdgeIndex e = work[head];
+      queued[e] = false;
+      if (mesh_.edgeTriangleCount(e) != 2)
+        continue;
+      const auto [first, second] = mesh_.edgeTriangles(e);
+      VertexIndex a = 0, c = 0;
+      for (int k = 0; k < 3; ++k)
+        if (candidates_[first].edges[k] == e) {
+          a = candidates_[first].vertices[k];
+          c = candidates_[first].vertices[(k + 1) % 3];
+        }
+      const VertexIndex b = apexOf(first, a, c), d = apexOf(second, a, c);
+      if (angleAt(b, a, c) + angleAt(d, a, c) <= M_PI + swap_angle_tolerance)
+        continue;
+      const CandidateIndex abd = candidateWith(edgeBetween(first, a, b), d);
+      const CandidateIndex bcd = candidateWith(edgeBetween(first, b, c), d);
+      if (abd == no_candidate || bcd == no_candidate || state_[abd] == State::accepted ||
+          state_[bcd] == State::accepted)
+        continue;
+      if (mesh_.edgeTriangleCount(edgeBetween(abd, b, d)) != 0)
+        continue;
+      const double bending_before = bendingAngle(points_[a], points_[c], points_[b], points_[d]);
+      const double bending_after = bendingAngle(points_[b], points_[d], points_[a], points_[c]);
+      if (bending_after > std::max(bending_before, smooth_bending_angle))
+        continue;
+      for (CandidateIndex old : {first, second}) {
+        mesh_.remove(old);
+        propagateContext(old, -1.0);
+        state_[old] = State::dropped;
+      }
+      for (CandidateIndex replacement : {abd, bcd}) {
+        if (isQueued(replacement))
+          queueOf(state_[replacement]).erase(handles_[replacement]);
+        mesh_.add(replacement);
+        state_[replacement] = State::accepted;
+        propagateContext(replacement, +1.0);
+        for (EdgeIndex outer : candidates_[replacement].edges)
+          enqueue(outer);
+      }
+      ++statistics_.swapped_pairs;
+    }
+  }
+
+  // ---- clean-up ------------------------------------------------------------
+
+  void removeFlapsAndIsolatedTriangles() {
+    std::vector<CandidateIndex> loose;
+    for (CandidateIndex t = 0; t < candidates_.size(); ++t) {
+      if (!mesh_.contains(t))
+        continue;
+      int shared_edges = 0;
+      for (EdgeIndex e : candidates_[t].edges)
+        shared_edges += mesh_.edgeTriangleCount(e) == 2;
+      if (shared_edges <= 1)
+        loose.push_back(t);
+    }
+    for (CandidateIndex t : loose)
+      undo(t);
+    statistics_.cleanup_undone += loose.size();
+  }
+
+  /// Final guarantee: every vertex's triangles form one fan. At a bow-tie the
+  /// fan with the most triangles stays (ties: the cheaper one) and the others
+  /// are undone; removals can split fans at neighbouring vertices, so those
+  /// are checked again.
+  void enforceManifoldVertices() {
+    std::vector<VertexIndex> pending;
+    for (VertexIndex v = 0; v < points_.size(); ++v)
+      if (!mesh_.vertexTriangles(v).empty())
+        pending.push_back(v);
+    std::vector<bool> is_pending(points_.size(), true);
+    while (!pending.empty()) {
+      const VertexIndex v = pending.back();
+      pending.pop_back();
+      is_pending[v] = false;
+      const auto fans = mesh_.fansAround(v);
+      if (fans.size() <= 1)
+        continue;
+      std::size_t best = 0;
+      for (std::size_t f = 1; f < fans.size(); ++f)
+        if (fans[f].size() > fans[best].size() ||
+            (fans[f].size() == fans[best].size() && fanCost(fans[f]) < fanCost(fans[best])))
+          best = f;
+      for (std::size_t f = 0; f < fans.size(); ++f) {
+        if (f == best)
+          continue;
+        for (CandidateIndex u : fans[f]) {
+          mesh_.remove(u);
+          propagateContext(u, -1.0);
+          state_[u] = State::dropped;
+          ++statistics_.cleanup_undone;
+          for (VertexIndex w : candidates_[u].vertices)
+            if (w != v && !is_pending[w]) {
+              is_pending[w] = true;
+              pending.push_back(w);
+            }
+        }
+      }
+    }
+  }
+
+  double fanCost(const std::vector<CandidateIndex> &fan) const {
+    double total = 0;
+    for (CandidateIndex u : fan)
+      total += cost_[u];
+    return total;
+  }
+
+  const MedialScaffold &scaffold_;
+  const std::vector<Candidate> &candidates_;
+  const std::vector<Eigen::Vector3d> &points_;
+  const Parameters &parameters_;
+  GreedyStatistics &statistics_;
+  MeshTopology mesh_;
+
+  std::vector<double> context_;
+  std::vector<float> cost_;
+  std::vector<State> state_;
+  std::vector<std::uint8_t> incidence_delays_, ranking_delays_, undos_;
+  std::vector<Queue::handle_type> handles_;
+  std::vector<bool> multi_fan_vertex_;
+  std::vector<double> delay_multiplier_;
+  Queue queue1_, queue2_;
+  bool queue2_built_ = false;
+};
+
+GreedyMesher::GreedyMesher(const MedialScaffold &scaffold,
+                           const std::vector<Eigen::Vector3d> &points,
+                           const Parameters &parameters)
+    : impl_(std::make_unique<Impl>(scaffold, points, parameters, statistics_)) {}
+
+GreedyMesher::~GreedyMesher() = default;
+
+void GreedyMesher::run() { impl_->run(); }
+
+std::vector<Triangle> GreedyMesher::triangles() const { return impl_->triangles(); }
+
+const MeshTopology &GreedyMesher::mesh() const { return impl_->mesh(); }
+
+} // namespace pcl_ms

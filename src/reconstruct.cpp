@@ -1,0 +1,206 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <pcl_ms/finish.h>
+#include <pcl_ms/greedy.h>
+#include <pcl_ms/reconstruct.h>
+#include <pcl_ms/scaffold.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <sstream>
+
+namespace pcl_ms {
+
+std::string Parameters::validate() const {
+  std::ostringstream reason;
+  if (!(std::isfinite(rho) && rho > 0))
+    reason << "rho must be a positive number (got " << rho << ")";
+  else if (fill_holes_max_edges < 0)
+    reason << "fill_holes must be 0 (off) or a number of edges >= 3 (got " << fill_holes_max_edges
+           << ")";
+  else if (!(std::isfinite(normal_weight) && normal_weight >= 0))
+    reason << "normal weight must be >= 0 (got " << normal_weight << ")";
+  else if (!(close_ranking_tolerance >= 0 && close_ranking_tolerance < 1))
+    reason << "close-ranking tolerance must be in [0, 1) (got " << close_ranking_tolerance << ")";
+  else if (!(std::isfinite(delay_factor) && delay_factor > 1))
+    reason << "delay factor must be > 1 (got " << delay_factor << ")";
+  else if (max_delays < 0 || max_delays > 100)
+    reason << "max delays must be in [0, 100] (got " << max_delays << ")";
+  else if (num_threads < 0)
+    reason << "number of threads must be >= 0 (got " << num_threads << ")";
+  return reason.str();
+}
+
+std::size_t Result::numberOfNonOrientableComponents() const {
+  return static_cast<std::size_t>(
+      std::count(component_orientable.begin(), component_orientable.end(), false));
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// The distinct, finite points of the user's records, centred on their
+/// bounding box (circumcentres of far-off points lose precision otherwise),
+/// and for each the user record it stands for.
+struct PreparedPoints {
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<Eigen::Vector3f> normals;
+  std::vector<VertexIndex> user_index;
+};
+
+const float *recordAt(const float *base, std::size_t stride, std::size_t record) {
+  return reinterpret_cast<const float *>(reinterpret_cast<const char *>(base) + record * stride);
+}
+
+PreparedPoints preparePoints(const PointView &view, bool with_normals, Result &result) {
+  const std::size_t count = view.indices ? view.indices->size() : view.size;
+  result.input_points = count;
+  if (count > 0 && !view.xyz)
+    throw ReconstructionError("the point array is null");
+  if (view.size >= std::numeric_limits<VertexIndex>::max())
+    throw ReconstructionError("too many points for 32-bit indices");
+
+  std::vector<VertexIndex> records;
+  records.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    std::size_t record = i;
+    if (view.indices) {
+      const int index = (*view.indices)[i];
+      if (index < 0 || static_cast<std::size_t>(index) >= view.size)
+        throw ReconstructionError("index " + std::to_string(index) + " is outside the cloud of " +
+                                  std::to_string(view.size) + " points");
+      record = static_cast<std::size_t>(index);
+    }
+    const float *p = recordAt(view.xyz, view.stride, record);
+    if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))
+      records.push_back(static_cast<VertexIndex>(record));
+    else
+      ++result.invalid_points;
+  }
+
+  // Exact duplicates: sort by coordinates, keep the earliest record of each.
+  auto coordinates = [&](VertexIndex record) {
+    const float *p = recordAt(view.xyz, view.stride, record);
+    return std::array<float, 3>{p[0], p[1], p[2]};
+  };
+  std::vector<std::size_t> order(records.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    const auto pa = coordinates(records[a]), pb = coordinates(records[b]);
+    return pa < pb || (pa == pb && a < b);
+  });
+  std::vector<bool> keep(records.size(), true);
+  for (std::size_t i = 1; i < order.size(); ++i)
+    if (coordinates(records[order[i]]) == coordinates(records[order[i - 1]]))
+      keep[order[i]] = false;
+
+  PreparedPoints prepared;
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d high = -low;
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    if (!keep[i]) {
+      ++result.duplicate_points;
+      continue;
+    }
+    const float *p = recordAt(view.xyz, view.stride, records[i]);
+    const Eigen::Vector3d position(p[0], p[1], p[2]);
+    low = low.cwiseMin(position);
+    high = high.cwiseMax(position);
+    prepared.positions.push_back(position);
+    prepared.user_index.push_back(records[i]);
+    if (with_normals) {
+      const float *n = recordAt(view.normals, view.normal_stride, records[i]);
+      Eigen::Vector3f normal(n[0], n[1], n[2]);
+      const float length = normal.norm();
+      // An unusable normal is zero: it then neither helps nor penalises.
+      prepared.normals.push_back(std::isfinite(length) && length > 0 ? Eigen::Vector3f(normal / length)
+                                                                      : Eigen::Vector3f::Zero());
+    }
+  }
+  result.used_points = prepared.positions.size();
+  if (prepared.positions.size() < 3) {
+    std::ostringstream reason;
+    reason << "need at least 3 distinct valid points, got " << prepared.positions.size() << " ("
+           << count << " given, " << result.invalid_points << " NaN/Inf, "
+           << result.duplicate_points << " duplicates)";
+    throw ReconstructionError(reason.str());
+  }
+  const Eigen::Vector3d centre = 0.5 * (low + high);
+  for (Eigen::Vector3d &position : prepared.positions)
+    position -= centre;
+  return prepared;
+}
+
+} // namespace
+
+Result reconstruct(const PointView &points, const Parameters &parameters) {
+  const Clock::time_point start = Clock::now();
+  const std::string invalid = parameters.validate();
+  if (!invalid.empty())
+    throw ReconstructionError(invalid);
+  if (parameters.use_normals && !points.normals)
+    throw ReconstructionError("normals were requested but none were given");
+
+  Result result;
+  Clock::time_point stage = Clock::now();
+  const PreparedPoints prepared = preparePoints(points, parameters.use_normals, result);
+  result.timings.prepare = secondsSince(stage);
+
+  stage = Clock::now();
+  ScaffoldOptions options;
+  options.rho = parameters.rho;
+  options.num_threads = parameters.num_threads;
+  options.normals = parameters.use_normals ? &prepared.normals : nullptr;
+  options.normal_weight = parameters.normal_weight;
+  const MedialScaffold scaffold = buildMedialScaffold(prepared.positions, options);
+  result.timings.delaunay = scaffold.delaunay_seconds;
+  result.timings.scaffold = secondsSince(stage) - scaffold.delaunay_seconds;
+  result.planar = scaffold.planar;
+  result.d_med = scaffold.d_med;
+  result.d_max = scaffold.d_max;
+  result.candidates_type1 = scaffold.type1;
+  result.candidates_type2 = scaffold.type2;
+  result.candidates_type3 = scaffold.type3;
+  result.candidates_oversize = scaffold.oversize;
+
+  stage = Clock::now();
+  std::vector<Triangle> triangles;
+  {
+    GreedyMesher mesher(scaffold, prepared.positions, parameters);
+    mesher.run();
+    triangles = mesher.triangles();
+    result.pass1 = mesher.statistics().pass1;
+    result.pass2 = mesher.statistics().pass2;
+    result.cleanup_undone = mesher.statistics().cleanup_undone;
+    result.swapped_pairs = mesher.statistics().swapped_pairs;
+  }
+  result.timings.greedy = secondsSince(stage);
+
+  stage = Clock::now();
+  FinishedSurface surface =
+      finishSurface(std::move(triangles), prepared.positions, parameters.fill_holes_max_edges);
+  // Back to the user's records.
+  for (Triangle &triangle : surface.triangles)
+    for (VertexIndex &v : triangle)
+      v = prepared.user_index[v];
+  for (auto &loop : surface.boundary_loops)
+    for (VertexIndex &v : loop)
+      v = prepared.user_index[v];
+  result.triangles = std::move(surface.triangles);
+  result.boundary_loops = std::move(surface.boundary_loops);
+  result.triangle_component = std::move(surface.triangle_component);
+  result.component_orientable = std::move(surface.component_orientable);
+  result.holes_filled = surface.holes_filled;
+  result.timings.finish = secondsSince(stage);
+  result.timings.total = secondsSince(start);
+  return result;
+}
+
+} // namespace pcl_ms

@@ -1,0 +1,407 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <pcl_ms/costs.h>
+#include <pcl_ms/reconstruct.h>
+#include <pcl_ms/scaffold.h>
+
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Delaunay_triangulation_cell_base_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_cell_base_with_info_3.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace pcl_ms {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using KernelPoint = Kernel::Point_3;
+using VertexBase = CGAL::Triangulation_vertex_base_with_info_3<VertexIndex, Kernel>;
+using CellBase = CGAL::Triangulation_cell_base_with_info_3<
+    std::uint32_t, Kernel, CGAL::Delaunay_triangulation_cell_base_3<Kernel>>;
+using DataStructure = CGAL::Triangulation_data_structure_3<VertexBase, CellBase>;
+using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, DataStructure>;
+using CellHandle = Delaunay::Cell_handle;
+using VertexHandle = Delaunay::Vertex_handle;
+
+// Cells per unit of parallel work. Chunks are fixed ranges of the cell order,
+// so the output does not depend on how many threads process them.
+constexpr std::size_t cells_per_chunk = 4096;
+
+// Cells sampled to estimate d_med.
+constexpr std::size_t median_sample_cells = 100000;
+
+// A vanishing shock length (co-spherical points) must not divide by zero.
+constexpr double min_shock_length_fraction = 1e-6;
+
+Eigen::Vector3d toEigen(const KernelPoint &p) { return {p.x(), p.y(), p.z()}; }
+
+/// The three vertices of facet (cell, i), or false when one is infinite.
+bool facetVertices(const Delaunay &delaunay, CellHandle cell, int i,
+                   std::array<VertexHandle, 3> &vertices) {
+  for (int k = 0; k < 3; ++k) {
+    vertices[k] = cell->vertex((i + 1 + k) & 3);
+    if (delaunay.is_infinite(vertices[k]))
+      return false;
+  }
+  return true;
+}
+
+/// Whether the facet's smallest circumscribing sphere has no Delaunay
+/// neighbour strictly inside, decided with exact predicates: then the
+/// circumcentre lies on the dual Voronoi edge (types I and II).
+bool isGabriel(const Delaunay &delaunay, CellHandle cell, int i,
+               const std::array<VertexHandle, 3> &vertices) {
+  const auto side_of_bounded_sphere = Kernel().side_of_bounded_sphere_3_object();
+  const CellHandle neighbour = cell->neighbor(i);
+  const VertexHandle opposite[2] = {cell->vertex(i), neighbour->vertex(neighbour->index(cell))};
+  for (const VertexHandle &apex : opposite) {
+    if (delaunay.is_infinite(apex))
+      continue;
+    if (side_of_bounded_sphere(vertices[0]->point(), vertices[1]->point(), vertices[2]->point(),
+                               apex->point()) == CGAL::ON_BOUNDED_SIDE)
+      return false;
+  }
+  return true;
+}
+
+struct Circle {
+  Eigen::Vector3d centre;
+  Eigen::Vector3d unit_normal;
+  double radius;
+};
+
+Circle circumcircle(const Eigen::Vector3d &a, const Eigen::Vector3d &b, const Eigen::Vector3d &c) {
+  const Eigen::Vector3d u = b - a, v = c - a, w = u.cross(v);
+  const double w_squared = w.squaredNorm();
+  Circle circle;
+  const Eigen::Vector3d offset =
+      (u.squaredNorm() * v.cross(w) + v.squaredNorm() * w.cross(u)) / (2.0 * w_squared);
+  circle.centre = a + offset;
+  circle.radius = offset.norm();
+  circle.unit_normal = w / std::sqrt(w_squared);
+  return circle;
+}
+
+std::size_t chunkCount(std::size_t items) { return (items + cells_per_chunk - 1) / cells_per_chunk; }
+
+template <typename ChunkWork>
+void forEachChunk(std::size_t items, int num_threads, const ChunkWork &work) {
+  const std::size_t chunks = chunkCount(items);
+  auto run = [&] {
+    tbb::parallel_for(std::size_t(0), chunks, [&](std::size_t chunk) {
+      work(chunk, chunk * cells_per_chunk, std::min(items, (chunk + 1) * cells_per_chunk));
+    });
+  };
+  if (num_threads == 1) {
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk)
+      work(chunk, chunk * cells_per_chunk, std::min(items, (chunk + 1) * cells_per_chunk));
+    return;
+  }
+  tbb::task_arena arena(num_threads > 0 ? num_threads : tbb::task_arena::automatic);
+  arena.execute(run);
+}
+
+double median(std::vector<float> &values) {
+  if (values.empty())
+    return 0;
+  auto middle = values.begin() + values.size() / 2;
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+/// Per-chunk output of the candidate pass.
+struct ChunkCandidates {
+  std::vector<Candidate> candidates;
+  std::size_t type_counts[4] = {0, 0, 0, 0};
+  std::size_t oversize = 0, degenerate = 0;
+};
+
+class ScaffoldBuilder {
+public:
+  ScaffoldBuilder(const std::vector<Eigen::Vector3d> &points, const ScaffoldOptions &options)
+      : points_(points), options_(options) {}
+
+  MedialScaffold build() {
+    const auto start = std::chrono::steady_clock::now();
+    Delaunay delaunay = triangulate();
+    scaffold_.delaunay_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+    if (delaunay.dimension() < 2)
+      throw ReconstructionError("all points are collinear: no surface can be built");
+    scaffold_.planar = delaunay.dimension() == 2;
+
+    collectCells(delaunay);
+    scaffold_.d_med = medianCircumradius(delaunay);
+    scaffold_.d_max = options_.rho * scaffold_.d_med;
+    buildCandidates(delaunay);
+    // The tetrahedra are no longer needed: free them before the edge graph.
+    cells_.clear();
+    cells_.shrink_to_fit();
+    delaunay.clear();
+    buildEdgeGraph();
+    return std::move(scaffold_);
+  }
+
+private:
+  Delaunay triangulate() const {
+    std::vector<std::pair<KernelPoint, VertexIndex>> input;
+    input.reserve(points_.size());
+    for (std::size_t i = 0; i < points_.size(); ++i)
+      input.emplace_back(KernelPoint(points_[i].x(), points_[i].y(), points_[i].z()),
+                         static_cast<VertexIndex>(i));
+    // Range insertion sorts spatially; symbolic perturbation makes the
+    // triangulation unique even for co-spherical points.
+    return Delaunay(input.begin(), input.end());
+  }
+
+  /// Numbers the cells (ids decide which of two cells owns a shared facet)
+  /// and lists them in a fixed order for chunked processing.
+  void collectCells(const Delaunay &delaunay) {
+    std::uint32_t id = 0;
+    cells_.reserve(delaunay.tds().number_of_cells());
+    for (CellHandle cell : delaunay.all_cell_handles()) {
+      cell->info() = id++;
+      cells_.push_back(cell);
+    }
+  }
+
+  /// Calls visit(cell, i, vertices) once for every finite facet owned by cell.
+  template <typename Visit>
+  void forEachOwnedFacet(const Delaunay &delaunay, CellHandle cell, const Visit &visit) const {
+    std::array<VertexHandle, 3> vertices;
+    if (scaffold_.planar) {
+      // In dimension 2 each finite face is stored as a cell of its own.
+      if (!delaunay.is_infinite(cell)) {
+        vertices = {cell->vertex(0), cell->vertex(1), cell->vertex(2)};
+        visit(cell, 3, vertices);
+      }
+      return;
+    }
+    for (int i = 0; i < 4; ++i) {
+      // Each facet is shared by two cells: the one with the smaller id owns it.
+      if (cell->info() > cell->neighbor(i)->info())
+        continue;
+      if (facetVertices(delaunay, cell, i, vertices))
+        visit(cell, i, vertices);
+    }
+  }
+
+  /// d_med: median circumradius of the type I and II triangles (all
+  /// triangles in the planar case, where every Voronoi edge is a line).
+  double medianCircumradius(const Delaunay &delaunay) {
+    // A fixed stride of cells estimates the median as well as all of them.
+    const std::size_t stride = std::max<std::size_t>(1, cells_.size() / median_sample_cells);
+    std::vector<std::vector<float>> chunk_radii(chunkCount(cells_.size()));
+    forEachChunk(cells_.size(), options_.num_threads,
+                 [&](std::size_t chunk, std::size_t begin, std::size_t end) {
+                   std::vector<float> &radii = chunk_radii[chunk];
+                   for (std::size_t index = begin; index < end; ++index) {
+                     if (index % stride != 0)
+                       continue;
+                     forEachOwnedFacet(delaunay, cells_[index], [&](CellHandle cell, int i,
+                                                                    const auto &vertices) {
+                       const KernelPoint &a = vertices[0]->point(), &b = vertices[1]->point(),
+                                         &c = vertices[2]->point();
+                       if (CGAL::collinear(a, b, c))
+                         return;
+                       if (!scaffold_.planar && !isGabriel(delaunay, cell, i, vertices))
+                         return;
+                       radii.push_back(static_cast<float>(
+                           circumcircle(toEigen(a), toEigen(b), toEigen(c)).radius));
+                     });
+                   }
+                 });
+    std::vector<float> radii;
+    for (const auto &chunk : chunk_radii)
+      radii.insert(radii.end(), chunk.begin(), chunk.end());
+    if (radii.empty())
+      throw ReconstructionError("all points are collinear: no surface can be built");
+    return median(radii);
+  }
+
+  /// The shorter piece of the dual Voronoi edge cut by the circumcentre.
+  double shockLength(const Delaunay &delaunay, CellHandle cell, int i, const Circle &circle) const {
+    double shortest = std::numeric_limits<double>::infinity();
+    for (CellHandle side : {cell, cell->neighbor(i)}) {
+      if (delaunay.is_infinite(side))
+        continue; // that piece is a ray: infinitely long
+      const Eigen::Vector3d voronoi_vertex = toEigen(delaunay.dual(side));
+      shortest = std::min(shortest, std::abs((voronoi_vertex - circle.centre).dot(circle.unit_normal)));
+    }
+    return shortest;
+  }
+
+  /// Mean |n_T . n_v| over the vertices with a usable (non-zero) normal.
+  double normalAgreement(const std::array<VertexIndex, 3> &ids,
+                         const Eigen::Vector3d &unit_normal) const {
+    double sum = 0;
+    int usable = 0;
+    for (VertexIndex id : ids) {
+      const Eigen::Vector3d normal = (*options_.normals)[id].cast<double>();
+      if (normal.squaredNorm() == 0)
+        continue;
+      sum += std::abs(unit_normal.dot(normal));
+      ++usable;
+    }
+    return usable ? sum / usable : 1.0;
+  }
+
+  void buildCandidates(const Delaunay &delaunay) {
+    std::vector<ChunkCandidates> chunks(chunkCount(cells_.size()));
+    const double min_shock_length = min_shock_length_fraction * scaffold_.d_med;
+    forEachChunk(cells_.size(), options_.num_threads, [&](std::size_t chunk, std::size_t begin,
+                                                         std::size_t end) {
+      ChunkCandidates &out = chunks[chunk];
+      for (std::size_t index = begin; index < end; ++index)
+        forEachOwnedFacet(delaunay, cells_[index], [&](CellHandle cell, int i,
+                                                       const std::array<VertexHandle, 3> &handles) {
+          if (CGAL::collinear(handles[0]->point(), handles[1]->point(), handles[2]->point())) {
+            ++out.degenerate;
+            return;
+          }
+        Candidate candidate;
+        for (int k = 0; k < 3; ++k)
+          candidate.vertices[k] = handles[k]->info();
+        std::sort(candidate.vertices.begin(), candidate.vertices.end());
+        const Eigen::Vector3d &a = points_[candidate.vertices[0]],
+                              &b = points_[candidate.vertices[1]],
+                              &c = points_[candidate.vertices[2]];
+        const TriangleShape shape = triangleShape(a, b, c);
+        if (shape.longest_side >= scaffold_.d_max) {
+          ++out.oversize;
+          return;
+        }
+        const Circle circle = circumcircle(a, b, c);
+        double shock_length;
+        if (scaffold_.planar) {
+          // Both Voronoi pieces are infinite in a plane: rank by shape and size.
+          candidate.type = CandidateType::acute;
+          shock_length = scaffold_.d_med;
+        } else if (isGabriel(delaunay, cell, i, handles)) {
+          const bool acute =
+              CGAL::angle(handles[2]->point(), handles[0]->point(), handles[1]->point()) ==
+                  CGAL::ACUTE &&
+              CGAL::angle(handles[0]->point(), handles[1]->point(), handles[2]->point()) ==
+                  CGAL::ACUTE &&
+              CGAL::angle(handles[1]->point(), handles[2]->point(), handles[0]->point()) ==
+                  CGAL::ACUTE;
+          candidate.type = acute ? CandidateType::acute : CandidateType::obtuse;
+          shock_length = shockLength(delaunay, cell, i, circle);
+        } else {
+          // Type III has no A1^3-2 point on its curve: use the typical spacing.
+          candidate.type = CandidateType::ambiguous;
+          shock_length = scaffold_.d_med;
+        }
+        shock_length = std::max(shock_length, min_shock_length);
+        const double compactness_squared = shape.compactness * shape.compactness;
+        double base_cost = baseCost(shape.perimeter, shock_length, shape.compactness);
+        if (options_.normals)
+          base_cost *= 1.0 + options_.normal_weight *
+                                 (1.0 - normalAgreement(candidate.vertices, circle.unit_normal));
+        candidate.base_cost = static_cast<float>(base_cost);
+        candidate.inverse_shock_compactness =
+            static_cast<float>(1.0 / (shock_length * compactness_squared));
+        candidate.edges = {0, 0, 0};
+        ++out.type_counts[static_cast<int>(candidate.type)];
+        out.candidates.push_back(candidate);
+        });
+    });
+    std::size_t total = 0;
+    for (const auto &chunk : chunks)
+      total += chunk.candidates.size();
+    scaffold_.candidates.reserve(total);
+    for (auto &chunk : chunks) {
+      scaffold_.candidates.insert(scaffold_.candidates.end(), chunk.candidates.begin(),
+                                  chunk.candidates.end());
+      scaffold_.type1 += chunk.type_counts[1];
+      scaffold_.type2 += chunk.type_counts[2];
+      scaffold_.type3 += chunk.type_counts[3];
+      scaffold_.oversize += chunk.oversize;
+      scaffold_.degenerate += chunk.degenerate;
+      chunk = ChunkCandidates();
+    }
+  }
+
+  /// Numbers the candidates' edges and lists the candidates on each edge.
+  void buildEdgeGraph() {
+    std::vector<Candidate> &candidates = scaffold_.candidates;
+    const std::size_t n = points_.size();
+    // Neighbours b > a of every vertex a, via counting sort then per-vertex dedup.
+    std::vector<std::uint32_t> offsets(n + 1, 0);
+    auto forEachEdge = [&](auto &&visit) {
+      for (CandidateIndex t = 0; t < candidates.size(); ++t) {
+        const auto &v = candidates[t].vertices;
+        visit(t, 0, v[0], v[1]);
+        visit(t, 1, v[1], v[2]);
+        visit(t, 2, v[0], v[2]);
+      }
+    };
+    forEachEdge([&](CandidateIndex, int, VertexIndex low, VertexIndex) { ++offsets[low + 1]; });
+    std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+    std::vector<VertexIndex> neighbours(offsets[n]);
+    {
+      std::vector<std::uint32_t> cursor(offsets.begin(), offsets.end() - 1);
+      forEachEdge([&](CandidateIndex, int, VertexIndex low, VertexIndex high) {
+        neighbours[cursor[low]++] = high;
+      });
+    }
+    std::vector<std::uint32_t> unique_offsets(n + 1, 0);
+    std::size_t write = 0;
+    for (std::size_t a = 0; a < n; ++a) {
+      auto begin = neighbours.begin() + offsets[a], end = neighbours.begin() + offsets[a + 1];
+      std::sort(begin, end);
+      const auto unique_end = std::unique(begin, end);
+      unique_offsets[a] = static_cast<std::uint32_t>(write);
+      for (auto it = begin; it != unique_end; ++it)
+        neighbours[write++] = *it;
+    }
+    unique_offsets[n] = static_cast<std::uint32_t>(write);
+    neighbours.resize(write);
+    neighbours.shrink_to_fit();
+    const std::size_t edge_count = write;
+
+    auto edgeId = [&](VertexIndex low, VertexIndex high) {
+      const auto begin = neighbours.begin() + unique_offsets[low];
+      const auto end = neighbours.begin() + unique_offsets[low + 1];
+      return static_cast<EdgeIndex>(std::lower_bound(begin, end, high) - neighbours.begin());
+    };
+    scaffold_.edge_offsets.assign(edge_count + 1, 0);
+    forEachEdge([&](CandidateIndex t, int k, VertexIndex low, VertexIndex high) {
+      const EdgeIndex e = edgeId(low, high);
+      candidates[t].edges[k] = e;
+      ++scaffold_.edge_offsets[e + 1];
+    });
+    std::partial_sum(scaffold_.edge_offsets.begin(), scaffold_.edge_offsets.end(),
+                     scaffold_.edge_offsets.begin());
+    scaffold_.edge_candidates.resize(3 * candidates.size());
+    std::vector<std::uint32_t> cursor(scaffold_.edge_offsets.begin(),
+                                      scaffold_.edge_offsets.end() - 1);
+    for (CandidateIndex t = 0; t < candidates.size(); ++t)
+      for (EdgeIndex e : candidates[t].edges)
+        scaffold_.edge_candidates[cursor[e]++] = t;
+  }
+
+  const std::vector<Eigen::Vector3d> &points_;
+  const ScaffoldOptions &options_;
+  MedialScaffold scaffold_;
+  std::vector<CellHandle> cells_;
+};
+
+} // namespace
+
+MedialScaffold buildMedialScaffold(const std::vector<Eigen::Vector3d> &points,
+                                   const ScaffoldOptions &options) {
+  return ScaffoldBuilder(points, options).build();
+}
+
+} // namespace pcl_ms
