@@ -30,8 +30,9 @@ enum ExitCode { kSuccess = 0, kBadArguments = 1, kIoFailure = 2, kReconstruction
 
 struct Options {
   std::string input, output;
-  double rho = 10.0;
-  int fill_holes = 0;
+  // Defaults come from the library so that the tool and the class agree.
+  double rho = pcl_ms::Parameters().rho;
+  int fill_holes = pcl_ms::Parameters().fill_holes_max_edges;
   bool normals = false;
   int threads = 1;
   bool quiet = false;
@@ -47,11 +48,11 @@ void printHelp(const char *program) {
   print_info("Options:\n");
   print_info("  -rho X          no triangle side reaches X * d_med, d_med being the median\n"
              "                  circumradius of the candidate triangles (default ");
-  print_value("10");
+  print_value("%g", pcl_ms::Parameters().rho);
   print_info(")\n");
-  print_info("  -fill_holes K   close boundary loops of at most K edges (default ");
-  print_value("0");
-  print_info(" = off)\n");
+  print_info("  -fill_holes K   close boundary loops of at most K edges, 0 = off (default ");
+  print_value("%d", pcl_ms::Parameters().fill_holes_max_edges);
+  print_info(")\n");
   print_info("  -normals        use the cloud's normal_x/y/z fields to guide the surface\n");
   print_info("  -threads N      threads for the parallel stages, 0 = all cores (default ");
   print_value("1");

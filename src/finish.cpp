@@ -66,7 +66,7 @@ bool runsFromTo(const Triangle &t, VertexIndex a, VertexIndex b) {
 /// Minimum-cost triangulation of one boundary loop, or nothing.
 std::vector<Triangle> triangulateLoop(const std::vector<VertexIndex> &loop,
                                       const std::vector<Eigen::Vector3d> &points,
-                                      const std::vector<EdgeKey> &mesh_edges) {
+                                      const std::vector<EdgeKey> &mesh_edges, double max_side) {
   using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
   using VertexBase = CGAL::Triangulation_vertex_base_with_info_3<std::size_t, Kernel>;
   using DataStructure = CGAL::Triangulation_data_structure_3<VertexBase>;
@@ -112,7 +112,10 @@ std::vector<Triangle> triangulateLoop(const std::vector<VertexIndex> &loop,
         if (best[i][k] == infinity || best[k][j] == infinity || !allowed.count({i, k, j}))
           continue;
         const TriangleShape shape = triangleShape(points[loop[i]], points[loop[k]], points[loop[j]]);
-        if (shape.compactness <= 0)
+        // A triangular hole takes its one triangle whatever its size; larger
+        // loops keep the greedy's size limit, or fillings would reach across
+        // concave spots.
+        if (shape.compactness <= 0 || (m > 3 && shape.longest_side >= max_side))
           continue;
         const double cost =
             best[i][k] + best[k][j] + shape.perimeter / (shape.compactness * shape.compactness);
@@ -193,7 +196,7 @@ std::vector<std::vector<VertexIndex>> traceBoundaryLoops(const std::vector<Trian
 }
 
 std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen::Vector3d> &points,
-                      int max_edges) {
+                      int max_edges, double max_side) {
   if (max_edges < 3)
     return 0;
   const auto loops = traceBoundaryLoops(triangles);
@@ -213,7 +216,7 @@ std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen:
   for (const auto &loop : loops) {
     if (loop.size() < 3 || loop.size() > static_cast<std::size_t>(max_edges))
       continue;
-    std::vector<Triangle> filling = triangulateLoop(loop, points, mesh_edges);
+    std::vector<Triangle> filling = triangulateLoop(loop, points, mesh_edges, max_side);
     bool duplicates_existing = false;
     for (Triangle t : filling) {
       std::sort(t.begin(), t.end());
@@ -313,9 +316,10 @@ void orientComponents(std::vector<Triangle> &triangles, const std::vector<Eigen:
 }
 
 FinishedSurface finishSurface(std::vector<Triangle> triangles,
-                              const std::vector<Eigen::Vector3d> &points, int fill_holes_max_edges) {
+                              const std::vector<Eigen::Vector3d> &points, int fill_holes_max_edges,
+                              double max_side) {
   FinishedSurface surface;
-  surface.holes_filled = fillHoles(triangles, points, fill_holes_max_edges);
+  surface.holes_filled = fillHoles(triangles, points, fill_holes_max_edges, max_side);
   orientComponents(triangles, points, surface.triangle_component, surface.component_orientable);
   surface.boundary_loops = traceBoundaryLoops(triangles);
   surface.triangles = std::move(triangles);

@@ -17,7 +17,7 @@ std::string Parameters::validate() const {
   std::ostringstream reason;
   if (!(std::isfinite(rho) && rho > 0))
     reason << "rho must be a positive number (got " << rho << ")";
-  else if (fill_holes_max_edges < 0)
+  else if (fill_holes_max_edges < 0 || fill_holes_max_edges == 1 || fill_holes_max_edges == 2)
     reason << "fill_holes must be 0 (off) or a number of edges >= 3 (got " << fill_holes_max_edges
            << ")";
   else if (!(std::isfinite(normal_weight) && normal_weight >= 0))
@@ -185,7 +185,8 @@ Result reconstruct(const PointView &points, const Parameters &parameters) {
 
   stage = Clock::now();
   FinishedSurface surface =
-      finishSurface(std::move(triangles), prepared.positions, parameters.fill_holes_max_edges);
+      finishSurface(std::move(triangles), prepared.positions, parameters.fill_holes_max_edges,
+                    scaffold.d_max);
   // Back to the user's records.
   for (Triangle &triangle : surface.triangles)
     for (VertexIndex &v : triangle)

@@ -167,6 +167,13 @@ private:
   /// Numbers the cells (ids decide which of two cells owns a shared facet)
   /// and lists them in a fixed order for chunked processing.
   void collectCells(const Delaunay &delaunay) {
+    if (scaffold_.planar) {
+      // In dimension 2 each finite face is stored as a cell of its own.
+      for (auto facet = delaunay.finite_facets_begin(); facet != delaunay.finite_facets_end();
+           ++facet)
+        cells_.push_back(facet->first);
+      return;
+    }
     std::uint32_t id = 0;
     cells_.reserve(delaunay.tds().number_of_cells());
     for (CellHandle cell : delaunay.all_cell_handles()) {
@@ -180,11 +187,8 @@ private:
   void forEachOwnedFacet(const Delaunay &delaunay, CellHandle cell, const Visit &visit) const {
     std::array<VertexHandle, 3> vertices;
     if (scaffold_.planar) {
-      // In dimension 2 each finite face is stored as a cell of its own.
-      if (!delaunay.is_infinite(cell)) {
-        vertices = {cell->vertex(0), cell->vertex(1), cell->vertex(2)};
-        visit(cell, 3, vertices);
-      }
+      vertices = {cell->vertex(0), cell->vertex(1), cell->vertex(2)};
+      visit(cell, 3, vertices);
       return;
     }
     for (int i = 0; i < 4; ++i) {

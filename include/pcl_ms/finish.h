@@ -27,9 +27,10 @@ std::vector<std::vector<VertexIndex>> traceBoundaryLoops(const std::vector<Trian
 
 /// Closes loops of at most max_edges edges with triangles of the Delaunay
 /// triangulation of the loop's vertices (minimum total P / C^2, no edge
-/// that the mesh already has inside the hole). Returns the holes closed.
+/// that the mesh already has inside the hole, sides below max_side except
+/// for a triangular hole). Returns the holes closed.
 std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen::Vector3d> &points,
-                      int max_edges);
+                      int max_edges, double max_side);
 
 /// Orients every component consistently by a breadth-first walk over shared
 /// edges (outward for closed components: positive signed volume); a
@@ -40,6 +41,7 @@ void orientComponents(std::vector<Triangle> &triangles, const std::vector<Eigen:
 
 /// All of the above in order.
 FinishedSurface finishSurface(std::vector<Triangle> triangles,
-                              const std::vector<Eigen::Vector3d> &points, int fill_holes_max_edges);
+                              const std::vector<Eigen::Vector3d> &points, int fill_holes_max_edges,
+                              double max_side);
 
 } // namespace pcl_ms

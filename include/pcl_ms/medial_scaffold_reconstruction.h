@@ -47,13 +47,14 @@ public:
   void reconstruct(pcl::PointCloud<PointInT> &points,
                    std::vector<pcl::Vertices> &polygons) override;
 
-  /** \brief d_max = rho * d_med caps triangle sides (default 10; the paper
-   * uses 5-15, 30 closes the bunny's base holes). Must be > 0. */
+  /** \brief d_max = rho * d_med caps triangle sides, d_med being the median
+   * circumradius of the Gabriel Delaunay triangles (default 5; the paper uses
+   * 5-15, 30 closes the bunny's base holes). Must be > 0. */
   void setRho(double rho) { parameters_.rho = rho; }
   double getRho() const { return parameters_.rho; }
 
   /** \brief Close boundary loops of at most \a max_edges edges with Delaunay
-   * triangles (default 0 = off). */
+   * triangles of the loop's points (default 8; 0 = off, else >= 3). */
   void setFillHoles(int max_edges) { parameters_.fill_holes_max_edges = max_edges; }
   int getFillHoles() const { return parameters_.fill_holes_max_edges; }
 

@@ -62,7 +62,7 @@ struct MedialScaffold {
 };
 
 struct ScaffoldOptions {
-  double rho = 10.0;
+  double rho = Parameters().rho;
   int num_threads = 1;
   /// Optional unit normals per point (same indexing as points) and kappa.
   const std::vector<Eigen::Vector3f> *normals = nullptr;

@@ -1,0 +1,297 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Unit tests of each core stage on configurations whose answers are known by hand.
+#include "test_support.h"
+
+#include <pcl_ms/costs.h>
+#include <pcl_ms/finish.h>
+#include <pcl_ms/greedy.h>
+#include <pcl_ms/mesh_topology.h>
+#include <pcl_ms/scaffold.h>
+
+#include <algorithm>
+#include <set>
+
+using namespace pcl_ms;
+using pcl_ms_test::expectCleanManifold;
+
+namespace {
+
+std::vector<Eigen::Vector3d> regularTetrahedron() {
+  // Edge length 1.
+  return {{0, 0, 0}, {1, 0, 0}, {0.5, std::sqrt(3.0) / 2, 0}, {0.5, std::sqrt(3.0) / 6, std::sqrt(2.0 / 3.0)}};
+}
+
+std::vector<Eigen::Vector3d> cubeCorners() {
+  std::vector<Eigen::Vector3d> corners;
+  for (int i = 0; i < 8; ++i)
+    corners.emplace_back(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+  return corners;
+}
+
+const Candidate *findCandidate(const MedialScaffold &scaffold, Triangle vertices) {
+  std::sort(vertices.begin(), vertices.end());
+  for (const Candidate &candidate : scaffold.candidates)
+    if (candidate.vertices == vertices)
+      return &candidate;
+  return nullptr;
+}
+
+Result runOn(const std::vector<Eigen::Vector3d> &points, Parameters parameters = {}) {
+  std::vector<float> xyz;
+  for (const auto &p : points)
+    xyz.insert(xyz.end(), {float(p.x()), float(p.y()), float(p.z())});
+  return reconstruct(pcl_ms_test::viewOf(xyz), parameters);
+}
+
+} // namespace
+
+// ---- costs ------------------------------------------------------------------
+
+TEST(Costs, CompactnessOfKnownTriangles) {
+  EXPECT_NEAR(triangleShape({0, 0, 0}, {1, 0, 0}, {0.5, std::sqrt(3.0) / 2, 0}).compactness, 1.0, 1e-12);
+  // Right isosceles: A = 1/2, sum of squared sides = 4.
+  EXPECT_NEAR(triangleShape({0, 0, 0}, {1, 0, 0}, {0, 1, 0}).compactness, std::sqrt(3.0) / 2, 1e-12);
+  const TriangleShape flat = triangleShape({0, 0, 0}, {1, 0, 0}, {2, 0, 0});
+  EXPECT_EQ(flat.area, 0.0);
+  EXPECT_EQ(flat.compactness, 0.0);
+  EXPECT_DOUBLE_EQ(flat.perimeter, 4.0);
+  EXPECT_DOUBLE_EQ(flat.longest_side, 2.0);
+}
+
+TEST(Costs, BendingAngleAcrossSharedEdge) {
+  const Eigen::Vector3d p(0, 0, 0), q(1, 0, 0), t(0.3, 1, 0);
+  EXPECT_NEAR(bendingAngle(p, q, t, {0.7, -2, 0}), 0.0, 1e-12);      // flat continuation
+  EXPECT_NEAR(bendingAngle(p, q, t, {0.1, 0.5, 0}), M_PI, 1e-12);    // folded back
+  EXPECT_NEAR(bendingAngle(p, q, t, {0.5, 0, 3}), M_PI / 2, 1e-12);  // right angle
+}
+
+TEST(Costs, BendingPenaltyMatchesPaper) {
+  EXPECT_DOUBLE_EQ(bendingPenalty(0.0), -1.0);
+  // The paper: f is about 0 at 40 degrees (exactly at ln 2, 39.7 degrees)
+  // and about 8.24 at 80 degrees.
+  EXPECT_NEAR(bendingPenalty(std::log(2.0)), 0.0, 1e-12);
+  EXPECT_NEAR(bendingPenalty(40.0 * M_PI / 180), 0.0, 0.03);
+  EXPECT_NEAR(bendingPenalty(80.0 * M_PI / 180), 8.24, 0.01);
+  // Three flat neighbours cancel the base cost (Eq. 1 vs Eq. 2).
+  const double inverse = 1.0 / (0.5 * 0.9 * 0.9);
+  const double base = baseCost(3.0, 0.5, 0.9);
+  EXPECT_NEAR(base + 3 * contextCost(1.0, inverse, 0.0), 0.0, 1e-12);
+}
+
+// ---- scaffold -----------------------------------------------------------------
+
+TEST(Scaffold, RegularTetrahedronHasFourAcuteCandidates) {
+  const MedialScaffold scaffold = buildMedialScaffold(regularTetrahedron(), {});
+  ASSERT_EQ(scaffold.candidates.size(), 4u);
+  EXPECT_EQ(scaffold.type1, 4u);
+  EXPECT_EQ(scaffold.type2 + scaffold.type3 + scaffold.oversize, 0u);
+  EXPECT_FALSE(scaffold.planar);
+  EXPECT_NEAR(scaffold.d_med, 1.0 / std::sqrt(3.0), 1e-6); // face circumradius
+  EXPECT_NEAR(scaffold.d_max, Parameters().rho / std::sqrt(3.0), 1e-5);
+  // Hull facets: the finite piece of the Voronoi ray runs from the face's
+  // circumcentre to the tetrahedron's, i.e. the inradius 1 / (2 sqrt 6).
+  const double inradius = 1.0 / (2.0 * std::sqrt(6.0));
+  for (const Candidate &candidate : scaffold.candidates) {
+    EXPECT_EQ(candidate.type, CandidateType::acute);
+    EXPECT_NEAR(candidate.base_cost, 3.0 / inradius, 1e-4);
+    EXPECT_NEAR(candidate.inverse_shock_compactness, 1.0 / inradius, 1e-4);
+  }
+  // Six edges, each shared by two faces.
+  ASSERT_EQ(scaffold.numberOfEdges(), 6u);
+  for (EdgeIndex e = 0; e < 6; ++e)
+    EXPECT_EQ(scaffold.edgeEnd(e) - scaffold.edgeBegin(e), 2);
+}
+
+TEST(Scaffold, ObtuseGabrielTriangleIsTypeTwo) {
+  const std::vector<Eigen::Vector3d> points = {{0, 0, 0}, {1, 0, 0}, {0.5, 0.2, 0}, {0.5, 0.1, 5}};
+  const MedialScaffold scaffold = buildMedialScaffold(points, {});
+  const Candidate *base = findCandidate(scaffold, {0, 1, 2});
+  ASSERT_NE(base, nullptr);
+  EXPECT_EQ(base->type, CandidateType::obtuse);
+}
+
+TEST(Scaffold, TriangleWithPointInItsDiametralSphereIsTypeThree) {
+  // d hovers just above abc, well inside the sphere through a, b, c centred in their plane.
+  const std::vector<Eigen::Vector3d> points = {{0, 0, 0}, {1, 0, 0}, {0.5, 0.9, 0}, {0.5, 0.3, 0.05}};
+  const MedialScaffold scaffold = buildMedialScaffold(points, {});
+  const Candidate *base = findCandidate(scaffold, {0, 1, 2});
+  ASSERT_NE(base, nullptr);
+  EXPECT_EQ(base->type, CandidateType::ambiguous);
+  // Type III ranks with R = d_med.
+  const TriangleShape shape = triangleShape(points[0], points[1], points[2]);
+  EXPECT_NEAR(base->base_cost,
+              baseCost(shape.perimeter, scaffold.d_med, shape.compactness), 1e-4 * base->base_cost);
+}
+
+TEST(Scaffold, OversizeCandidatesAreNotKept) {
+  // A unit square of four points and one far point: triangles to it exceed
+  // d_max with rho = 1 and are counted as oversize.
+  const std::vector<Eigen::Vector3d> points = {
+      {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0.1}, {0.5, 0.5, 40}};
+  ScaffoldOptions options;
+  options.rho = 1.0;
+  const MedialScaffold scaffold = buildMedialScaffold(points, options);
+  EXPECT_GT(scaffold.oversize, 0u);
+  for (const Candidate &candidate : scaffold.candidates)
+    EXPECT_TRUE(std::find(candidate.vertices.begin(), candidate.vertices.end(), 4u) ==
+                candidate.vertices.end());
+}
+
+TEST(Scaffold, PlanarGridGivesTwoDimensionalDelaunay) {
+  std::vector<Eigen::Vector3d> grid;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j)
+      grid.emplace_back(i, j, 0);
+  const MedialScaffold scaffold = buildMedialScaffold(grid, {});
+  EXPECT_TRUE(scaffold.planar);
+  EXPECT_EQ(scaffold.candidates.size(), 32u); // 16 squares, two triangles each
+  EXPECT_NEAR(scaffold.d_med, std::sqrt(0.5), 1e-6);
+}
+
+TEST(Scaffold, CollinearPointsAreRejected) {
+  const std::vector<Eigen::Vector3d> line = {{0, 0, 0}, {1, 1, 1}, {2, 2, 2}, {3, 3, 3}};
+  EXPECT_THROW(buildMedialScaffold(line, {}), ReconstructionError);
+}
+
+// ---- mesh topology ---------------------------------------------------------------
+
+TEST(MeshTopology, CountsFollowAddAndRemove) {
+  const MedialScaffold scaffold = buildMedialScaffold(regularTetrahedron(), {});
+  MeshTopology mesh(scaffold, 4);
+  mesh.add(0);
+  for (VertexIndex v : scaffold.candidates[0].vertices) {
+    EXPECT_EQ(mesh.vertexBoundaryEdges(v), 2);
+    EXPECT_FALSE(mesh.isClosedVertex(v));
+  }
+  mesh.add(1);
+  int shared = 0;
+  for (EdgeIndex e = 0; e < scaffold.numberOfEdges(); ++e)
+    shared += mesh.edgeTriangleCount(e) == 2;
+  EXPECT_EQ(shared, 1);
+  mesh.add(2);
+  mesh.add(3);
+  EXPECT_EQ(mesh.size(), 4u);
+  for (VertexIndex v = 0; v < 4; ++v) {
+    EXPECT_TRUE(mesh.isClosedVertex(v));
+    EXPECT_EQ(mesh.fansAround(v).size(), 1u);
+    EXPECT_EQ(mesh.vertexTriangles(v).size(), 3u);
+  }
+  mesh.remove(3);
+  EXPECT_FALSE(mesh.contains(3));
+  for (VertexIndex v : scaffold.candidates[3].vertices)
+    EXPECT_FALSE(mesh.isClosedVertex(v));
+}
+
+// ---- greedy ------------------------------------------------------------------------
+
+TEST(Greedy, TetrahedronClosesIntoFourTriangles) {
+  const MedialScaffold scaffold = buildMedialScaffold(regularTetrahedron(), {});
+  const std::vector<Eigen::Vector3d> points = regularTetrahedron();
+  Parameters parameters;
+  GreedyMesher mesher(scaffold, points, parameters);
+  mesher.run();
+  EXPECT_EQ(mesher.triangles().size(), 4u);
+  EXPECT_EQ(mesher.statistics().pass1.accepted, 4u);
+}
+
+TEST(Greedy, CubeCornersGiveTheSixSquareFaces) {
+  const Result result = runOn(cubeCorners());
+  ASSERT_EQ(result.triangles.size(), 12u);
+  for (const Triangle &t : result.triangles) {
+    // Every triangle lies in a face: its three corners share one coordinate.
+    const auto corners = cubeCorners();
+    bool on_face = false;
+    for (int axis = 0; axis < 3; ++axis)
+      on_face |= corners[t[0]][axis] == corners[t[1]][axis] && corners[t[1]][axis] == corners[t[2]][axis];
+    EXPECT_TRUE(on_face);
+  }
+  EXPECT_TRUE(result.boundary_loops.empty());
+  ASSERT_EQ(result.numberOfComponents(), 1u);
+  EXPECT_TRUE(result.component_orientable[0]);
+}
+
+TEST(Greedy, SphereSamplingIsAClosedGenusZeroSurface) {
+  const std::vector<float> xyz = pcl_ms_test::fibonacciSphere(400);
+  const Result result = reconstruct(pcl_ms_test::viewOf(xyz), {});
+  const MeshTopologyReport report = analyzeMesh(pcl_ms_test::positions(xyz), result.triangles);
+  expectCleanManifold(report);
+  EXPECT_EQ(report.boundary_edges, 0u);
+  EXPECT_EQ(report.components, 1u);
+  EXPECT_EQ(report.euler_characteristic, 2);
+  EXPECT_EQ(report.referenced_vertices, 400u);
+  EXPECT_TRUE(report.orientable);
+  EXPECT_EQ(report.inconsistently_oriented_edges, 0u);
+  EXPECT_EQ(result.triangles.size(), 2u * 400 - 4);
+}
+
+// ---- finish --------------------------------------------------------------------------
+
+TEST(Finish, BoundaryLoopOfTwoTriangles) {
+  const std::vector<Triangle> square = {{0, 1, 2}, {0, 2, 3}};
+  const auto loops = traceBoundaryLoops(square);
+  ASSERT_EQ(loops.size(), 1u);
+  EXPECT_EQ(loops[0], (std::vector<VertexIndex>{0, 1, 2, 3}));
+}
+
+TEST(Finish, FillsTheMissingFaceOfACube) {
+  const std::vector<Eigen::Vector3d> corners = cubeCorners();
+  // The cube's faces as two triangles each, the top (z = 1) left out.
+  const std::vector<Triangle> open_box = {{0, 2, 1}, {1, 2, 3}, {0, 1, 5}, {0, 5, 4}, {1, 3, 7},
+                                          {1, 7, 5}, {3, 2, 6}, {3, 6, 7}, {2, 0, 4}, {2, 4, 6}};
+  FinishedSurface kept = finishSurface(open_box, corners, 3, 10.0);
+  EXPECT_EQ(kept.holes_filled, 0u); // the hole has 4 edges, more than 3
+  EXPECT_EQ(kept.boundary_loops.size(), 1u);
+  FinishedSurface too_small = finishSurface(open_box, corners, 4, 1.2); // diagonal 1.41
+  EXPECT_EQ(too_small.holes_filled, 0u);
+  FinishedSurface closed = finishSurface(open_box, corners, 4, 10.0);
+  EXPECT_EQ(closed.holes_filled, 1u);
+  EXPECT_EQ(closed.triangles.size(), 12u);
+  EXPECT_TRUE(closed.boundary_loops.empty());
+  const MeshTopologyReport report = analyzeMesh(corners, closed.triangles);
+  expectCleanManifold(report);
+  EXPECT_EQ(report.euler_characteristic, 2);
+  EXPECT_EQ(report.inconsistently_oriented_edges, 0u);
+}
+
+TEST(Finish, OrientsClosedSurfacesOutward) {
+  const std::vector<Eigen::Vector3d> points = regularTetrahedron();
+  std::vector<Triangle> faces = {{0, 1, 2}, {0, 1, 3}, {1, 2, 3}, {0, 2, 3}}; // mixed orientation
+  std::vector<std::uint32_t> component;
+  std::vector<bool> orientable;
+  orientComponents(faces, points, component, orientable);
+  ASSERT_EQ(orientable.size(), 1u);
+  EXPECT_TRUE(orientable[0]);
+  const Eigen::Vector3d centre = (points[0] + points[1] + points[2] + points[3]) / 4;
+  for (const Triangle &t : faces) {
+    const Eigen::Vector3d normal = (points[t[1]] - points[t[0]]).cross(points[t[2]] - points[t[0]]);
+    EXPECT_GT(normal.dot(points[t[0]] - centre), 0) << "face points inward";
+  }
+}
+
+TEST(Finish, MoebiusStripIsReportedNonOrientable) {
+  // A strip of 5 quads whose ends are glued with a half twist.
+  std::vector<Eigen::Vector3d> points;
+  const int segments = 5;
+  for (int i = 0; i < segments; ++i) {
+    const double angle = 2 * M_PI * i / segments, twist = angle / 2;
+    for (double side : {-0.3, 0.3}) {
+      const double r = 1 + side * std::cos(twist);
+      points.emplace_back(r * std::cos(angle), r * std::sin(angle), side * std::sin(twist));
+    }
+  }
+  std::vector<Triangle> strip;
+  for (int i = 0; i < segments; ++i) {
+    const VertexIndex a = 2 * i, b = 2 * i + 1;
+    VertexIndex c = 2 * ((i + 1) % segments), d = c + 1;
+    if (i == segments - 1)
+      std::swap(c, d); // the half twist
+    strip.push_back({a, b, d});
+    strip.push_back({a, d, c});
+  }
+  std::vector<std::uint32_t> component;
+  std::vector<bool> orientable;
+  orientComponents(strip, points, component, orientable);
+  ASSERT_EQ(orientable.size(), 1u);
+  EXPECT_FALSE(orientable[0]);
+  EXPECT_EQ(traceBoundaryLoops(strip).size(), 1u); // a Moebius strip has one boundary curve
+}
