@@ -82,7 +82,8 @@ std::vector<Triangle> triangulateLoop(const std::vector<VertexIndex> &loop,
   if (delaunay.dimension() < 2)
     return {};
   std::set<std::array<std::size_t, 3>> allowed;
-  for (auto facet = delaunay.finite_facets_begin(); facet != delaunay.finite_facets_end(); ++facet) {
+  for (auto facet = delaunay.finite_facets_begin(); facet != delaunay.finite_facets_end();
+       ++facet) {
     std::array<std::size_t, 3> corners;
     for (int k = 0; k < 3; ++k)
       corners[k] = facet->first->vertex((facet->second + 1 + k) & 3)->info();
@@ -111,7 +112,8 @@ std::vector<Triangle> triangulateLoop(const std::vector<VertexIndex> &loop,
       for (std::size_t k = i + 1; k < j; ++k) {
         if (best[i][k] == infinity || best[k][j] == infinity || !allowed.count({i, k, j}))
           continue;
-        const TriangleShape shape = triangleShape(points[loop[i]], points[loop[k]], points[loop[j]]);
+        const TriangleShape shape =
+            triangleShape(points[loop[i]], points[loop[k]], points[loop[j]]);
         // A triangular hole takes its one triangle whatever its size; larger
         // loops keep the greedy's size limit, or fillings would reach across
         // concave spots.
@@ -200,17 +202,29 @@ std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen:
   if (max_edges < 3)
     return 0;
   const auto loops = traceBoundaryLoops(triangles);
+  const bool any_small_loop = std::any_of(loops.begin(), loops.end(), [&](const auto &loop) {
+    return loop.size() <= static_cast<std::size_t>(max_edges);
+  });
+  if (!any_small_loop)
+    return 0;
   std::vector<EdgeKey> mesh_edges;
   for (const Triangle &t : triangles)
     for (int k = 0; k < 3; ++k)
       mesh_edges.push_back(edgeKey(t[k], t[(k + 1) % 3]));
   std::sort(mesh_edges.begin(), mesh_edges.end());
   mesh_edges.erase(std::unique(mesh_edges.begin(), mesh_edges.end()), mesh_edges.end());
+  // Existing triangles matter only where all three corners are on a loop.
+  std::vector<bool> on_small_loop(points.size(), false);
+  for (const auto &loop : loops)
+    if (loop.size() <= static_cast<std::size_t>(max_edges))
+      for (VertexIndex v : loop)
+        on_small_loop[v] = true;
   std::set<std::array<VertexIndex, 3>> existing;
-  for (Triangle t : triangles) {
-    std::sort(t.begin(), t.end());
-    existing.insert(t);
-  }
+  for (Triangle t : triangles)
+    if (on_small_loop[t[0]] && on_small_loop[t[1]] && on_small_loop[t[2]]) {
+      std::sort(t.begin(), t.end());
+      existing.insert(t);
+    }
 
   std::size_t filled = 0;
   for (const auto &loop : loops) {
@@ -305,8 +319,8 @@ void orientComponents(std::vector<Triangle> &triangles, const std::vector<Eigen:
       // Outward for closed surfaces; a fixed, reproducible choice otherwise.
       double signed_volume = 0;
       for (std::uint32_t t : members)
-        signed_volume += points[triangles[t][0]].dot(
-            points[triangles[t][1]].cross(points[triangles[t][2]]));
+        signed_volume +=
+            points[triangles[t][0]].dot(points[triangles[t][1]].cross(points[triangles[t][2]]));
       if (signed_volume < 0)
         for (std::uint32_t t : members)
           std::swap(triangles[t][1], triangles[t][2]);

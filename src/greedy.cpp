@@ -25,8 +25,9 @@ struct CheaperFirst {
   }
 };
 
-using Queue = boost::heap::d_ary_heap<QueueEntry, boost::heap::arity<4>, boost::heap::mutable_<true>,
-                                      boost::heap::compare<CheaperFirst>>;
+using Queue =
+    boost::heap::d_ary_heap<QueueEntry, boost::heap::arity<4>, boost::heap::mutable_<true>,
+                            boost::heap::compare<CheaperFirst>>;
 
 // An undone triangle is re-queued at most this often, so that two candidates
 // whose costs keep crossing cannot undo each other forever.
@@ -47,12 +48,12 @@ public:
   Impl(const MedialScaffold &scaffold, const std::vector<Eigen::Vector3d> &points,
        const Parameters &parameters, GreedyStatistics &statistics)
       : scaffold_(scaffold), candidates_(scaffold.candidates), points_(points),
-        parameters_(parameters), statistics_(statistics),
-        mesh_(scaffold, points.size()), context_(candidates_.size(), 0.0),
-        cost_(candidates_.size(), 0.f), state_(candidates_.size(), State::idle),
-        incidence_delays_(candidates_.size(), 0), ranking_delays_(candidates_.size(), 0),
-        undos_(candidates_.size(), 0), handles_(candidates_.size()),
-        multi_fan_vertex_(points.size(), false) {
+        parameters_(parameters), statistics_(statistics), mesh_(scaffold, points.size()),
+        context_(candidates_.size(), 0.0), cost_(candidates_.size(), 0.f),
+        state_(candidates_.size(), State::idle), incidence_delays_(candidates_.size(), 0),
+        ranking_delays_(candidates_.size(), 0), undos_(candidates_.size(), 0),
+        handles_(candidates_.size()), multi_fan_vertex_(points.size(), false),
+        may_have_several_fans_(points.size(), false) {
     delay_multiplier_.resize(2 * static_cast<std::size_t>(parameters.max_delays) + 1);
     for (std::size_t k = 0; k < delay_multiplier_.size(); ++k)
       delay_multiplier_[k] = std::pow(parameters.delay_factor, static_cast<double>(k));
@@ -306,8 +307,10 @@ private:
     for (VertexIndex v : candidates_[t].vertices) {
       if (created_second_fan && mesh_.edgeTriangleCount(mesh_.edgesAt(t, v)[0]) == 1 &&
           mesh_.edgeTriangleCount(mesh_.edgesAt(t, v)[1]) == 1 &&
-          mesh_.vertexTriangles(v).size() > 1)
+          mesh_.vertexTriangles(v).size() > 1) {
         multi_fan_vertex_[v] = true;
+        may_have_several_fans_[v] = true;
+      }
       if (multi_fan_vertex_[v])
         keepClosedFanOnly(v);
     }
@@ -334,6 +337,14 @@ private:
     multi_fan_vertex_[v] = false;
   }
 
+  /// Removing a triangle from the middle of a fan splits it in two: its
+  /// corners are checked again by the final manifold sweep.
+  void removeFromMesh(CandidateIndex t) {
+    mesh_.remove(t);
+    for (VertexIndex v : candidates_[t].vertices)
+      may_have_several_fans_[v] = true;
+  }
+
   bool isClosedFan(const std::vector<CandidateIndex> &fan, VertexIndex v) const {
     for (CandidateIndex u : fan)
       for (EdgeIndex e : mesh_.edgesAt(u, v))
@@ -344,7 +355,7 @@ private:
 
   /// Takes t out of the mesh and sends it to Q2 with a fresh cost.
   void undo(CandidateIndex t) {
-    mesh_.remove(t);
+    removeFromMesh(t);
     propagateContext(t, -1.0);
     cost_[t] = static_cast<float>(freshCost(t));
     if (++undos_[t] > max_undos) {
@@ -439,7 +450,7 @@ private:
       if (bending_after > std::max(bending_before, smooth_bending_angle))
         continue;
       for (CandidateIndex old : {first, second}) {
-        mesh_.remove(old);
+        removeFromMesh(old);
         propagateContext(old, -1.0);
         state_[old] = State::dropped;
       }
@@ -477,13 +488,17 @@ private:
   /// Final guarantee: every vertex's triangles form one fan. At a bow-tie the
   /// fan with the most triangles stays (ties: the cheaper one) and the others
   /// are undone; removals can split fans at neighbouring vertices, so those
-  /// are checked again.
+  /// are checked again. A vertex gets a second fan only when a triangle at it
+  /// was removed or accepted against the vertex-face incidence rule: only
+  /// those vertices are looked at.
   void enforceManifoldVertices() {
     std::vector<VertexIndex> pending;
+    std::vector<bool> is_pending(points_.size(), false);
     for (VertexIndex v = 0; v < points_.size(); ++v)
-      if (!mesh_.vertexTriangles(v).empty())
+      if (may_have_several_fans_[v] && !mesh_.vertexTriangles(v).empty()) {
         pending.push_back(v);
-    std::vector<bool> is_pending(points_.size(), true);
+        is_pending[v] = true;
+      }
     while (!pending.empty()) {
       const VertexIndex v = pending.back();
       pending.pop_back();
@@ -500,7 +515,7 @@ private:
         if (f == best)
           continue;
         for (CandidateIndex u : fans[f]) {
-          mesh_.remove(u);
+          removeFromMesh(u);
           propagateContext(u, -1.0);
           state_[u] = State::dropped;
           ++statistics_.cleanup_undone;
@@ -534,14 +549,14 @@ private:
   std::vector<std::uint8_t> incidence_delays_, ranking_delays_, undos_;
   std::vector<Queue::handle_type> handles_;
   std::vector<bool> multi_fan_vertex_;
+  std::vector<bool> may_have_several_fans_;
   std::vector<double> delay_multiplier_;
   Queue queue1_, queue2_;
   bool queue2_built_ = false;
 };
 
 GreedyMesher::GreedyMesher(const MedialScaffold &scaffold,
-                           const std::vector<Eigen::Vector3d> &points,
-                           const Parameters &parameters)
+                           const std::vector<Eigen::Vector3d> &points, const Parameters &parameters)
     : impl_(std::make_unique<Impl>(scaffold, points, parameters, statistics_)) {}
 
 GreedyMesher::~GreedyMesher() = default;

@@ -7,8 +7,7 @@
 namespace pcl_ms {
 
 MeshTopology::MeshTopology(const MedialScaffold &scaffold, std::size_t vertex_count)
-    : scaffold_(scaffold),
-      edge_slots_(scaffold.numberOfEdges(), {no_candidate, no_candidate}),
+    : scaffold_(scaffold), edge_slots_(scaffold.numberOfEdges(), {no_candidate, no_candidate}),
       vertex_triangles_(vertex_count), vertex_boundary_edges_(vertex_count, 0),
       in_mesh_(scaffold.candidates.size(), false) {}
 

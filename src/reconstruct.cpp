@@ -120,8 +120,9 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, Result &r
       Eigen::Vector3f normal(n[0], n[1], n[2]);
       const float length = normal.norm();
       // An unusable normal is zero: it then neither helps nor penalises.
-      prepared.normals.push_back(std::isfinite(length) && length > 0 ? Eigen::Vector3f(normal / length)
-                                                                      : Eigen::Vector3f::Zero());
+      prepared.normals.push_back(std::isfinite(length) && length > 0
+                                     ? Eigen::Vector3f(normal / length)
+                                     : Eigen::Vector3f::Zero());
     }
   }
   result.used_points = prepared.positions.size();
@@ -184,9 +185,8 @@ Result reconstruct(const PointView &points, const Parameters &parameters) {
   result.timings.greedy = secondsSince(stage);
 
   stage = Clock::now();
-  FinishedSurface surface =
-      finishSurface(std::move(triangles), prepared.positions, parameters.fill_holes_max_edges,
-                    scaffold.d_max);
+  FinishedSurface surface = finishSurface(std::move(triangles), prepared.positions,
+                                          parameters.fill_holes_max_edges, scaffold.d_max);
   // Back to the user's records.
   for (Triangle &triangle : surface.triangles)
     for (VertexIndex &v : triangle)

@@ -25,8 +25,9 @@ namespace {
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using KernelPoint = Kernel::Point_3;
 using VertexBase = CGAL::Triangulation_vertex_base_with_info_3<VertexIndex, Kernel>;
-using CellBase = CGAL::Triangulation_cell_base_with_info_3<
-    std::uint32_t, Kernel, CGAL::Delaunay_triangulation_cell_base_3<Kernel>>;
+using CellBase =
+    CGAL::Triangulation_cell_base_with_info_3<std::uint32_t, Kernel,
+                                              CGAL::Delaunay_triangulation_cell_base_3<Kernel>>;
 using DataStructure = CGAL::Triangulation_data_structure_3<VertexBase, CellBase>;
 using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, DataStructure>;
 using CellHandle = Delaunay::Cell_handle;
@@ -91,7 +92,9 @@ Circle circumcircle(const Eigen::Vector3d &a, const Eigen::Vector3d &b, const Ei
   return circle;
 }
 
-std::size_t chunkCount(std::size_t items) { return (items + cells_per_chunk - 1) / cells_per_chunk; }
+std::size_t chunkCount(std::size_t items) {
+  return (items + cells_per_chunk - 1) / cells_per_chunk;
+}
 
 template <typename ChunkWork>
 void forEachChunk(std::size_t items, int num_threads, const ChunkWork &work) {
@@ -206,25 +209,26 @@ private:
     // A fixed stride of cells estimates the median as well as all of them.
     const std::size_t stride = std::max<std::size_t>(1, cells_.size() / median_sample_cells);
     std::vector<std::vector<float>> chunk_radii(chunkCount(cells_.size()));
-    forEachChunk(cells_.size(), options_.num_threads,
-                 [&](std::size_t chunk, std::size_t begin, std::size_t end) {
-                   std::vector<float> &radii = chunk_radii[chunk];
-                   for (std::size_t index = begin; index < end; ++index) {
-                     if (index % stride != 0)
-                       continue;
-                     forEachOwnedFacet(delaunay, cells_[index], [&](CellHandle cell, int i,
-                                                                    const auto &vertices) {
-                       const KernelPoint &a = vertices[0]->point(), &b = vertices[1]->point(),
-                                         &c = vertices[2]->point();
-                       if (CGAL::collinear(a, b, c))
-                         return;
-                       if (!scaffold_.planar && !isGabriel(delaunay, cell, i, vertices))
-                         return;
-                       radii.push_back(static_cast<float>(
-                           circumcircle(toEigen(a), toEigen(b), toEigen(c)).radius));
-                     });
-                   }
-                 });
+    forEachChunk(
+        cells_.size(), options_.num_threads,
+        [&](std::size_t chunk, std::size_t begin, std::size_t end) {
+          std::vector<float> &radii = chunk_radii[chunk];
+          for (std::size_t index = begin; index < end; ++index) {
+            if (index % stride != 0)
+              continue;
+            forEachOwnedFacet(
+                delaunay, cells_[index], [&](CellHandle cell, int i, const auto &vertices) {
+                  const KernelPoint &a = vertices[0]->point(), &b = vertices[1]->point(),
+                                    &c = vertices[2]->point();
+                  if (CGAL::collinear(a, b, c))
+                    return;
+                  if (!scaffold_.planar && !isGabriel(delaunay, cell, i, vertices))
+                    return;
+                  radii.push_back(
+                      static_cast<float>(circumcircle(toEigen(a), toEigen(b), toEigen(c)).radius));
+                });
+          }
+        });
     std::vector<float> radii;
     for (const auto &chunk : chunk_radii)
       radii.insert(radii.end(), chunk.begin(), chunk.end());
@@ -240,7 +244,8 @@ private:
       if (delaunay.is_infinite(side))
         continue; // that piece is a ray: infinitely long
       const Eigen::Vector3d voronoi_vertex = toEigen(delaunay.dual(side));
-      shortest = std::min(shortest, std::abs((voronoi_vertex - circle.centre).dot(circle.unit_normal)));
+      shortest =
+          std::min(shortest, std::abs((voronoi_vertex - circle.centre).dot(circle.unit_normal)));
     }
     return shortest;
   }
@@ -263,63 +268,66 @@ private:
   void buildCandidates(const Delaunay &delaunay) {
     std::vector<ChunkCandidates> chunks(chunkCount(cells_.size()));
     const double min_shock_length = min_shock_length_fraction * scaffold_.d_med;
-    forEachChunk(cells_.size(), options_.num_threads, [&](std::size_t chunk, std::size_t begin,
-                                                         std::size_t end) {
-      ChunkCandidates &out = chunks[chunk];
-      for (std::size_t index = begin; index < end; ++index)
-        forEachOwnedFacet(delaunay, cells_[index], [&](CellHandle cell, int i,
-                                                       const std::array<VertexHandle, 3> &handles) {
-          if (CGAL::collinear(handles[0]->point(), handles[1]->point(), handles[2]->point())) {
-            ++out.degenerate;
-            return;
-          }
-        Candidate candidate;
-        for (int k = 0; k < 3; ++k)
-          candidate.vertices[k] = handles[k]->info();
-        std::sort(candidate.vertices.begin(), candidate.vertices.end());
-        const Eigen::Vector3d &a = points_[candidate.vertices[0]],
-                              &b = points_[candidate.vertices[1]],
-                              &c = points_[candidate.vertices[2]];
-        const TriangleShape shape = triangleShape(a, b, c);
-        if (shape.longest_side >= scaffold_.d_max) {
-          ++out.oversize;
-          return;
-        }
-        const Circle circle = circumcircle(a, b, c);
-        double shock_length;
-        if (scaffold_.planar) {
-          // Both Voronoi pieces are infinite in a plane: rank by shape and size.
-          candidate.type = CandidateType::acute;
-          shock_length = scaffold_.d_med;
-        } else if (isGabriel(delaunay, cell, i, handles)) {
-          const bool acute =
-              CGAL::angle(handles[2]->point(), handles[0]->point(), handles[1]->point()) ==
-                  CGAL::ACUTE &&
-              CGAL::angle(handles[0]->point(), handles[1]->point(), handles[2]->point()) ==
-                  CGAL::ACUTE &&
-              CGAL::angle(handles[1]->point(), handles[2]->point(), handles[0]->point()) ==
-                  CGAL::ACUTE;
-          candidate.type = acute ? CandidateType::acute : CandidateType::obtuse;
-          shock_length = shockLength(delaunay, cell, i, circle);
-        } else {
-          // Type III has no A1^3-2 point on its curve: use the typical spacing.
-          candidate.type = CandidateType::ambiguous;
-          shock_length = scaffold_.d_med;
-        }
-        shock_length = std::max(shock_length, min_shock_length);
-        const double compactness_squared = shape.compactness * shape.compactness;
-        double base_cost = baseCost(shape.perimeter, shock_length, shape.compactness);
-        if (options_.normals)
-          base_cost *= 1.0 + options_.normal_weight *
-                                 (1.0 - normalAgreement(candidate.vertices, circle.unit_normal));
-        candidate.base_cost = static_cast<float>(base_cost);
-        candidate.inverse_shock_compactness =
-            static_cast<float>(1.0 / (shock_length * compactness_squared));
-        candidate.edges = {0, 0, 0};
-        ++out.type_counts[static_cast<int>(candidate.type)];
-        out.candidates.push_back(candidate);
+    forEachChunk(
+        cells_.size(), options_.num_threads,
+        [&](std::size_t chunk, std::size_t begin, std::size_t end) {
+          ChunkCandidates &out = chunks[chunk];
+          for (std::size_t index = begin; index < end; ++index)
+            forEachOwnedFacet(
+                delaunay, cells_[index],
+                [&](CellHandle cell, int i, const std::array<VertexHandle, 3> &handles) {
+                  if (CGAL::collinear(handles[0]->point(), handles[1]->point(),
+                                      handles[2]->point())) {
+                    ++out.degenerate;
+                    return;
+                  }
+                  Candidate candidate;
+                  for (int k = 0; k < 3; ++k)
+                    candidate.vertices[k] = handles[k]->info();
+                  std::sort(candidate.vertices.begin(), candidate.vertices.end());
+                  const Eigen::Vector3d &a = points_[candidate.vertices[0]],
+                                        &b = points_[candidate.vertices[1]],
+                                        &c = points_[candidate.vertices[2]];
+                  const TriangleShape shape = triangleShape(a, b, c);
+                  if (shape.longest_side >= scaffold_.d_max) {
+                    ++out.oversize;
+                    return;
+                  }
+                  const Circle circle = circumcircle(a, b, c);
+                  double shock_length;
+                  if (scaffold_.planar) {
+                    // Both Voronoi pieces are infinite in a plane: rank by shape and size.
+                    candidate.type = CandidateType::acute;
+                    shock_length = scaffold_.d_med;
+                  } else if (isGabriel(delaunay, cell, i, handles)) {
+                    const bool acute = CGAL::angle(handles[2]->point(), handles[0]->point(),
+                                                   handles[1]->point()) == CGAL::ACUTE &&
+                                       CGAL::angle(handles[0]->point(), handles[1]->point(),
+                                                   handles[2]->point()) == CGAL::ACUTE &&
+                                       CGAL::angle(handles[1]->point(), handles[2]->point(),
+                                                   handles[0]->point()) == CGAL::ACUTE;
+                    candidate.type = acute ? CandidateType::acute : CandidateType::obtuse;
+                    shock_length = shockLength(delaunay, cell, i, circle);
+                  } else {
+                    // Type III has no A1^3-2 point on its curve: use the typical spacing.
+                    candidate.type = CandidateType::ambiguous;
+                    shock_length = scaffold_.d_med;
+                  }
+                  shock_length = std::max(shock_length, min_shock_length);
+                  const double compactness_squared = shape.compactness * shape.compactness;
+                  double base_cost = baseCost(shape.perimeter, shock_length, shape.compactness);
+                  if (options_.normals)
+                    base_cost *=
+                        1.0 + options_.normal_weight *
+                                  (1.0 - normalAgreement(candidate.vertices, circle.unit_normal));
+                  candidate.base_cost = static_cast<float>(base_cost);
+                  candidate.inverse_shock_compactness =
+                      static_cast<float>(1.0 / (shock_length * compactness_squared));
+                  candidate.edges = {0, 0, 0};
+                  ++out.type_counts[static_cast<int>(candidate.type)];
+                  out.candidates.push_back(candidate);
+                });
         });
-    });
     std::size_t total = 0;
     for (const auto &chunk : chunks)
       total += chunk.candidates.size();

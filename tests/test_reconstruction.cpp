@@ -81,8 +81,8 @@ TEST(Bunny, RecoversTheReferenceSurface) {
   // At the default rho the base keeps its larger openings (the reference has 5).
   EXPECT_LE(topology.boundary_loops, 5u);
 
-  const ReferenceReport report =
-      pcl_ms::compareWithReference(vertices, bunny.triangles, reference.vertices, reference.triangles);
+  const ReferenceReport report = pcl_ms::compareWithReference(
+      vertices, bunny.triangles, reference.vertices, reference.triangles);
   // CGAL's advancing front recovers 0.8888 of the reference triangles on these points.
   EXPECT_GE(report.recall, 0.888);
   EXPECT_GE(report.precision, 0.85);
@@ -125,8 +125,8 @@ TEST(Bunny, RawSingleViewScanStaysOnTheSurface) {
   EXPECT_GE(largestComponentTriangles(meshed.result), 0.95 * meshed.triangles.size());
   EXPECT_GE(topology.boundary_loops, 1u); // open where the scan ends
   const ReferenceMesh &reference = bunnyReference();
-  const ReferenceReport report =
-      pcl_ms::compareWithReference(vertices, meshed.triangles, reference.vertices, reference.triangles);
+  const ReferenceReport report = pcl_ms::compareWithReference(
+      vertices, meshed.triangles, reference.vertices, reference.triangles);
   EXPECT_LT(report.to_reference.max, 0.01);
 }
 
@@ -263,7 +263,8 @@ TEST(PclClass, GettersReturnDocumentedDefaults) {
 // ---- bad input -------------------------------------------------------------------------
 
 TEST(BadInput, EmptyCloud) {
-  const Meshed meshed = meshCloud<pcl::PointXYZ>(std::make_shared<pcl::PointCloud<pcl::PointXYZ>>());
+  const Meshed meshed =
+      meshCloud<pcl::PointXYZ>(std::make_shared<pcl::PointCloud<pcl::PointXYZ>>());
   EXPECT_FALSE(meshed.error.empty());
   EXPECT_TRUE(meshed.mesh.polygons.empty());
 }
@@ -278,7 +279,8 @@ TEST(BadInput, AllPointsNaN) {
 TEST(BadInput, SomeNaNAndInfPointsAreSkippedAndIndicesStayTheUsers) {
   const std::vector<float> sphere = fibonacciSphere(200);
   std::vector<float> mixed;
-  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity(),
+              nan = std::numeric_limits<float>::quiet_NaN();
   for (std::size_t i = 0; i < 200; ++i) {
     mixed.insert(mixed.end(), {sphere[3 * i], sphere[3 * i + 1], sphere[3 * i + 2]});
     if (i % 10 == 0)
@@ -325,7 +327,8 @@ TEST(BadInput, ExactDuplicatesAreMergedOntoTheFirstCopy) {
 TEST(BadInput, FewerThanThreeDistinctPoints) {
   const Meshed two = meshCloud<pcl::PointXYZ>(cloudOf({0, 0, 0, 1, 0, 0}));
   EXPECT_NE(two.error.find("at least 3 distinct"), std::string::npos) << two.error;
-  const Meshed repeated = meshCloud<pcl::PointXYZ>(cloudOf({0, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 1, 0, 0}));
+  const Meshed repeated =
+      meshCloud<pcl::PointXYZ>(cloudOf({0, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 1, 0, 0}));
   EXPECT_NE(repeated.error.find("3 duplicates"), std::string::npos) << repeated.error;
   EXPECT_TRUE(repeated.mesh.polygons.empty());
 }
@@ -357,7 +360,8 @@ TEST(BadInput, CoplanarCloudGivesItsPlanarDelaunayMesh) {
 TEST(BadInput, HugeOffsetAndTinyScaleGiveTheSameMesh) {
   const Meshed reference = meshCloud<pcl::PointXYZ>(cloudOf(fibonacciSphere(300)));
   // Float coordinates near 1e7 are 1 apart: use a sphere large enough to be resolved.
-  const Meshed far = meshCloud<pcl::PointXYZ>(cloudOf(fibonacciSphere(300, 2000.0, {1e7, -1e7, 1e7})));
+  const Meshed far =
+      meshCloud<pcl::PointXYZ>(cloudOf(fibonacciSphere(300, 2000.0, {1e7, -1e7, 1e7})));
   const Meshed tiny = meshCloud<pcl::PointXYZ>(cloudOf(fibonacciSphere(300, 1e-6)));
   ASSERT_TRUE(far.error.empty()) << far.error;
   ASSERT_TRUE(tiny.error.empty()) << tiny.error;
@@ -381,14 +385,18 @@ TEST(BadInput, InvalidParametersAreRejectedWithAReason) {
   EXPECT_NE(errorFor([](auto &p) { p.rho = -3; }).find("rho"), std::string::npos);
   EXPECT_NE(errorFor([](auto &p) { p.rho = std::numeric_limits<double>::quiet_NaN(); }).find("rho"),
             std::string::npos);
-  EXPECT_NE(errorFor([](auto &p) { p.fill_holes_max_edges = -1; }).find("fill_holes"), std::string::npos);
-  EXPECT_NE(errorFor([](auto &p) { p.fill_holes_max_edges = 2; }).find("fill_holes"), std::string::npos);
+  EXPECT_NE(errorFor([](auto &p) { p.fill_holes_max_edges = -1; }).find("fill_holes"),
+            std::string::npos);
+  EXPECT_NE(errorFor([](auto &p) { p.fill_holes_max_edges = 2; }).find("fill_holes"),
+            std::string::npos);
   EXPECT_NE(errorFor([](auto &p) { p.num_threads = -2; }).find("threads"), std::string::npos);
-  EXPECT_NE(errorFor([](auto &p) { p.delay_factor = 0.5; }).find("delay factor"), std::string::npos);
+  EXPECT_NE(errorFor([](auto &p) { p.delay_factor = 0.5; }).find("delay factor"),
+            std::string::npos);
   EXPECT_NE(errorFor([](auto &p) { p.close_ranking_tolerance = 1.5; }).find("tolerance"),
             std::string::npos);
   EXPECT_NE(errorFor([](auto &p) { p.max_delays = -1; }).find("max delays"), std::string::npos);
-  EXPECT_NE(errorFor([](auto &p) { p.normal_weight = -1; }).find("normal weight"), std::string::npos);
+  EXPECT_NE(errorFor([](auto &p) { p.normal_weight = -1; }).find("normal weight"),
+            std::string::npos);
 }
 
 TEST(BadInput, IndicesOutsideTheCloud) {

@@ -18,7 +18,10 @@ namespace {
 
 std::vector<Eigen::Vector3d> regularTetrahedron() {
   // Edge length 1.
-  return {{0, 0, 0}, {1, 0, 0}, {0.5, std::sqrt(3.0) / 2, 0}, {0.5, std::sqrt(3.0) / 6, std::sqrt(2.0 / 3.0)}};
+  return {{0, 0, 0},
+          {1, 0, 0},
+          {0.5, std::sqrt(3.0) / 2, 0},
+          {0.5, std::sqrt(3.0) / 6, std::sqrt(2.0 / 3.0)}};
 }
 
 std::vector<Eigen::Vector3d> cubeCorners() {
@@ -48,9 +51,11 @@ Result runOn(const std::vector<Eigen::Vector3d> &points, Parameters parameters =
 // ---- costs ------------------------------------------------------------------
 
 TEST(Costs, CompactnessOfKnownTriangles) {
-  EXPECT_NEAR(triangleShape({0, 0, 0}, {1, 0, 0}, {0.5, std::sqrt(3.0) / 2, 0}).compactness, 1.0, 1e-12);
+  EXPECT_NEAR(triangleShape({0, 0, 0}, {1, 0, 0}, {0.5, std::sqrt(3.0) / 2, 0}).compactness, 1.0,
+              1e-12);
   // Right isosceles: A = 1/2, sum of squared sides = 4.
-  EXPECT_NEAR(triangleShape({0, 0, 0}, {1, 0, 0}, {0, 1, 0}).compactness, std::sqrt(3.0) / 2, 1e-12);
+  EXPECT_NEAR(triangleShape({0, 0, 0}, {1, 0, 0}, {0, 1, 0}).compactness, std::sqrt(3.0) / 2,
+              1e-12);
   const TriangleShape flat = triangleShape({0, 0, 0}, {1, 0, 0}, {2, 0, 0});
   EXPECT_EQ(flat.area, 0.0);
   EXPECT_EQ(flat.compactness, 0.0);
@@ -60,9 +65,9 @@ TEST(Costs, CompactnessOfKnownTriangles) {
 
 TEST(Costs, BendingAngleAcrossSharedEdge) {
   const Eigen::Vector3d p(0, 0, 0), q(1, 0, 0), t(0.3, 1, 0);
-  EXPECT_NEAR(bendingAngle(p, q, t, {0.7, -2, 0}), 0.0, 1e-12);      // flat continuation
-  EXPECT_NEAR(bendingAngle(p, q, t, {0.1, 0.5, 0}), M_PI, 1e-12);    // folded back
-  EXPECT_NEAR(bendingAngle(p, q, t, {0.5, 0, 3}), M_PI / 2, 1e-12);  // right angle
+  EXPECT_NEAR(bendingAngle(p, q, t, {0.7, -2, 0}), 0.0, 1e-12);     // flat continuation
+  EXPECT_NEAR(bendingAngle(p, q, t, {0.1, 0.5, 0}), M_PI, 1e-12);   // folded back
+  EXPECT_NEAR(bendingAngle(p, q, t, {0.5, 0, 3}), M_PI / 2, 1e-12); // right angle
 }
 
 TEST(Costs, BendingPenaltyMatchesPaper) {
@@ -112,15 +117,16 @@ TEST(Scaffold, ObtuseGabrielTriangleIsTypeTwo) {
 
 TEST(Scaffold, TriangleWithPointInItsDiametralSphereIsTypeThree) {
   // d hovers just above abc, well inside the sphere through a, b, c centred in their plane.
-  const std::vector<Eigen::Vector3d> points = {{0, 0, 0}, {1, 0, 0}, {0.5, 0.9, 0}, {0.5, 0.3, 0.05}};
+  const std::vector<Eigen::Vector3d> points = {
+      {0, 0, 0}, {1, 0, 0}, {0.5, 0.9, 0}, {0.5, 0.3, 0.05}};
   const MedialScaffold scaffold = buildMedialScaffold(points, {});
   const Candidate *base = findCandidate(scaffold, {0, 1, 2});
   ASSERT_NE(base, nullptr);
   EXPECT_EQ(base->type, CandidateType::ambiguous);
   // Type III ranks with R = d_med.
   const TriangleShape shape = triangleShape(points[0], points[1], points[2]);
-  EXPECT_NEAR(base->base_cost,
-              baseCost(shape.perimeter, scaffold.d_med, shape.compactness), 1e-4 * base->base_cost);
+  EXPECT_NEAR(base->base_cost, baseCost(shape.perimeter, scaffold.d_med, shape.compactness),
+              1e-4 * base->base_cost);
 }
 
 TEST(Scaffold, OversizeCandidatesAreNotKept) {
@@ -202,7 +208,8 @@ TEST(Greedy, CubeCornersGiveTheSixSquareFaces) {
     const auto corners = cubeCorners();
     bool on_face = false;
     for (int axis = 0; axis < 3; ++axis)
-      on_face |= corners[t[0]][axis] == corners[t[1]][axis] && corners[t[1]][axis] == corners[t[2]][axis];
+      on_face |=
+          corners[t[0]][axis] == corners[t[1]][axis] && corners[t[1]][axis] == corners[t[2]][axis];
     EXPECT_TRUE(on_face);
   }
   EXPECT_TRUE(result.boundary_loops.empty());

@@ -18,7 +18,9 @@
 
 namespace pcl_ms_test {
 
-inline std::string dataPath(const std::string &name) { return std::string(PCL_MS_DATA_DIR) + "/" + name; }
+inline std::string dataPath(const std::string &name) {
+  return std::string(PCL_MS_DATA_DIR) + "/" + name;
+}
 
 inline pcl::PointCloud<pcl::PointXYZ>::Ptr loadXYZ(const std::string &name) {
   pcl::PCLPointCloud2 blob;

@@ -108,9 +108,7 @@ public:
   const std::string &getErrorMessage() const { return error_message_; }
 
 protected:
-  std::string getClassName() const override {
-    return "MedialScaffoldReconstruction";
-  }
+  std::string getClassName() const override { return "MedialScaffoldReconstruction"; }
 
   void performReconstruction(pcl::PolygonMesh &output) override;
   void performReconstruction(pcl::PointCloud<PointInT> &points,

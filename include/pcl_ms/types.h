@@ -70,11 +70,11 @@ struct PassStatistics {
 
 /// Wall-clock seconds per stage.
 struct StageTimings {
-  double prepare = 0;      // validation, NaN and duplicate removal
-  double delaunay = 0;     // Delaunay tetrahedralisation
-  double scaffold = 0;     // candidates, types, costs, candidate graph
-  double greedy = 0;       // passes 1 and 2 with clean-up
-  double finish = 0;       // manifold sweep, holes, orientation, loops
+  double prepare = 0;  // validation, NaN and duplicate removal
+  double delaunay = 0; // Delaunay tetrahedralisation
+  double scaffold = 0; // candidates, types, costs, candidate graph
+  double greedy = 0;   // passes 1 and 2 with clean-up
+  double finish = 0;   // manifold sweep, holes, orientation, loops
   double total = 0;
 };
 
@@ -99,8 +99,8 @@ struct Result {
   std::size_t candidates_oversize = 0;
   double d_med = 0, d_max = 0;
   PassStatistics pass1, pass2;
-  std::size_t cleanup_undone = 0;   // flaps/isolated triangles and final sweep
-  std::size_t swapped_pairs = 0;    // non-Delaunay quads re-triangulated
+  std::size_t cleanup_undone = 0; // flaps/isolated triangles and final sweep
+  std::size_t swapped_pairs = 0;  // non-Delaunay quads re-triangulated
   std::size_t holes_filled = 0;
   StageTimings timings;
 

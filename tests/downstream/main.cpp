@@ -24,8 +24,7 @@ int main() {
     const double r = std::sqrt(1.0 - z * z);
     const double phi = golden_angle * static_cast<double>(i);
     cloud->push_back(pcl::PointXYZ(static_cast<float>(r * std::cos(phi)),
-                                   static_cast<float>(r * std::sin(phi)),
-                                   static_cast<float>(z)));
+                                   static_cast<float>(r * std::sin(phi)), static_cast<float>(z)));
   }
 
   pcl::MedialScaffoldReconstruction<pcl::PointXYZ> msr;

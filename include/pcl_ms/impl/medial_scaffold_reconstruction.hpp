@@ -31,8 +31,8 @@ void MedialScaffoldReconstruction<PointInT>::reconstruct(pcl::PolygonMesh &outpu
 }
 
 template <typename PointInT>
-void MedialScaffoldReconstruction<PointInT>::reconstruct(
-    pcl::PointCloud<PointInT> &points, std::vector<pcl::Vertices> &polygons) {
+void MedialScaffoldReconstruction<PointInT>::reconstruct(pcl::PointCloud<PointInT> &points,
+                                                         std::vector<pcl::Vertices> &polygons) {
   if (!input_) {
     error_message_ = "no input cloud was given (call setInputCloud first)";
     PCL_ERROR("[pcl::%s::reconstruct] %s\n", getClassName().c_str(), error_message_.c_str());
@@ -70,8 +70,7 @@ bool MedialScaffoldReconstruction<PointInT>::runCore(std::vector<pcl::Vertices> 
       if (normals_->size() != input_->size()) {
         error_message_ = "the normal cloud has " + std::to_string(normals_->size()) +
                          " points but the input has " + std::to_string(input_->size());
-        PCL_ERROR("[pcl::%s::reconstruct] %s\n", getClassName().c_str(),
-                  error_message_.c_str());
+        PCL_ERROR("[pcl::%s::reconstruct] %s\n", getClassName().c_str(), error_message_.c_str());
         return false;
       }
       view.normals = normals_->empty() ? nullptr : &(*normals_)[0].normal_x;
@@ -125,5 +124,5 @@ std::vector<pcl::Vertices> MedialScaffoldReconstruction<PointInT>::getBoundaryLo
 
 } // namespace pcl
 
-#define PCL_INSTANTIATE_MedialScaffoldReconstruction(T)                                  \
+#define PCL_INSTANTIATE_MedialScaffoldReconstruction(T)                                            \
   template class PCL_EXPORTS pcl::MedialScaffoldReconstruction<T>;
