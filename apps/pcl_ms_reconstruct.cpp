@@ -132,6 +132,28 @@ private:
   pcl::console::VERBOSITY_LEVEL previous_;
 };
 
+/// Loads or saves with PCL's own console messages silenced (our one-line
+/// error says it all), timing the step and announcing it in PCL tool style.
+template <typename Step>
+bool fileStep(const char *verb, const std::string &path, bool verbose, double &milliseconds,
+              const Step &step) {
+  if (verbose) {
+    print_highlight("%s ", verb);
+    print_value("%s ", path.c_str());
+  }
+  pcl::console::TicToc timer;
+  timer.tic();
+  bool succeeded = false;
+  {
+    SilencePclMessages silence;
+    succeeded = step();
+  }
+  milliseconds = timer.toc();
+  if (!succeeded && verbose)
+    print_info("[failed]\n");
+  return succeeded;
+}
+
 /// Converts the cloud to PointT, meshes it and returns the polygons, which
 /// index the cloud's points directly.
 template <typename PointT>
@@ -236,23 +258,11 @@ int run(int argc, char **argv) {
 
   const bool verbose = !options.quiet;
   pcl::console::TicToc timer;
-  if (verbose) {
-    print_highlight("Loading ");
-    print_value("%s ", options.input.c_str());
-  }
-  timer.tic();
   pcl::PCLPointCloud2 cloud;
-  bool loaded = false;
-  {
-    SilencePclMessages silence;
-    loaded = pcl_ms::loadPointCloud(options.input, cloud, error);
-  }
-  const double load_ms = timer.toc();
-  if (!loaded) {
-    if (verbose)
-      print_info("[failed]\n");
+  double load_ms = 0;
+  if (!fileStep("Loading", options.input, verbose, load_ms,
+                [&] { return pcl_ms::loadPointCloud(options.input, cloud, error); }))
     return fail(kIoFailure, error);
-  }
   if (verbose) {
     print_info("[done, ");
     print_value("%.1f", load_ms);
@@ -300,22 +310,10 @@ int run(int argc, char **argv) {
   // The output keeps every field of the user's points, not just x, y, z.
   mesh.header = cloud.header;
   mesh.cloud = std::move(cloud);
-  if (verbose) {
-    print_highlight("Saving ");
-    print_value("%s ", options.output.c_str());
-  }
-  timer.tic();
-  bool saved = false;
-  {
-    SilencePclMessages silence;
-    saved = pcl_ms::saveMesh(options.output, mesh, error);
-  }
-  const double save_ms = timer.toc();
-  if (!saved) {
-    if (verbose)
-      print_info("[failed]\n");
+  double save_ms = 0;
+  if (!fileStep("Saving", options.output, verbose, save_ms,
+                [&] { return pcl_ms::saveMesh(options.output, mesh, error); }))
     return fail(kIoFailure, error);
-  }
   if (verbose) {
     print_info("[done, ");
     print_value("%.1f", save_ms);
