@@ -49,10 +49,7 @@ public:
        const Parameters &parameters, GreedyStatistics &statistics)
       : scaffold_(scaffold), candidates_(scaffold.candidates), points_(points),
         parameters_(parameters), statistics_(statistics), mesh_(scaffold, points.size()),
-        context_(candidates_.size(), 0.0), cost_(candidates_.size(), 0.f),
-        state_(candidates_.size(), State::idle), incidence_delays_(candidates_.size(), 0),
-        ranking_delays_(candidates_.size(), 0), undos_(candidates_.size(), 0),
-        handles_(candidates_.size()), multi_fan_vertex_(points.size(), false),
+        states_(candidates_.size()), multi_fan_vertex_(points.size(), false),
         may_have_several_fans_(points.size(), false) {
     delay_multiplier_.resize(2 * static_cast<std::size_t>(parameters.max_delays) + 1);
     for (std::size_t k = 0; k < delay_multiplier_.size(); ++k)
@@ -61,7 +58,7 @@ public:
 
   void run() {
     for (CandidateIndex t = 0; t < candidates_.size(); ++t) {
-      cost_[t] = static_cast<float>(freshCost(t));
+      states_[t].cost = static_cast<float>(freshCost(t));
       push(t, candidates_[t].type == CandidateType::ambiguous ? State::queue2 : State::queue1);
     }
     runPass(State::queue1, statistics_.pass1);
@@ -87,8 +84,8 @@ private:
   // ---- costs -------------------------------------------------------------
 
   double freshCost(CandidateIndex t) const {
-    const double undelayed = std::max(0.0, candidates_[t].base_cost + context_[t]);
-    return undelayed * delay_multiplier_[incidence_delays_[t] + ranking_delays_[t]];
+    const double undelayed = std::max(0.0, candidates_[t].base_cost + states_[t].context);
+    return undelayed * delay_multiplier_[states_[t].incidence_delays + states_[t].ranking_delays];
   }
 
   /// eps2 that accepted triangle `from` adds to candidate `to` across edge
@@ -118,9 +115,9 @@ private:
       for (const CandidateIndex *s = scaffold_.edgeBegin(e); s != scaffold_.edgeEnd(e); ++s) {
         // Dropped candidates never return; waiting Q2 members get their
         // context recomputed when Q2 is built.
-        if (*s == t || state_[*s] == State::dropped || isWaitingForQueue2(*s))
+        if (*s == t || states_[*s].state == State::dropped || isWaitingForQueue2(*s))
           continue;
-        context_[*s] += sign * contextTerm(t, k, *s);
+        states_[*s].context += sign * contextTerm(t, k, *s);
         refreshCost(*s);
       }
     }
@@ -141,27 +138,27 @@ private:
   }
 
   void refreshCost(CandidateIndex t) {
-    cost_[t] = static_cast<float>(freshCost(t));
+    states_[t].cost = static_cast<float>(freshCost(t));
     if (isQueued(t) && !isWaitingForQueue2(t))
-      queueOf(state_[t]).update(handles_[t], QueueEntry{cost_[t], t});
+      queueOf(states_[t].state).update(states_[t].handle, QueueEntry{states_[t].cost, t});
   }
 
   // ---- queues ------------------------------------------------------------
 
   bool isWaitingForQueue2(CandidateIndex t) const {
-    return !queue2_built_ && state_[t] == State::queue2;
+    return !queue2_built_ && states_[t].state == State::queue2;
   }
 
   bool isQueued(CandidateIndex t) const {
-    return state_[t] == State::queue1 || state_[t] == State::queue2;
+    return states_[t].state == State::queue1 || states_[t].state == State::queue2;
   }
   Queue &queueOf(State state) { return state == State::queue1 ? queue1_ : queue2_; }
 
   void push(CandidateIndex t, State queue) {
-    state_[t] = queue;
+    states_[t].state = queue;
     if (queue == State::queue2 && !queue2_built_)
       return; // queued when pass 2 starts
-    handles_[t] = queueOf(queue).push(QueueEntry{cost_[t], t});
+    states_[t].handle = queueOf(queue).push(QueueEntry{states_[t].cost, t});
   }
 
   /// Q2 waits through pass 1 untouched (most of it is type III far from the
@@ -171,16 +168,16 @@ private:
   void buildQueue2(PassStatistics &statistics) {
     queue2_built_ = true;
     for (CandidateIndex t = 0; t < candidates_.size(); ++t) {
-      if (state_[t] != State::queue2)
+      if (states_[t].state != State::queue2)
         continue;
       if (touchesClosedVertex(t)) {
-        state_[t] = State::dropped;
+        states_[t].state = State::dropped;
         ++statistics.rejected;
         continue;
       }
-      context_[t] = contextFromScratch(t);
-      cost_[t] = static_cast<float>(freshCost(t));
-      handles_[t] = queue2_.push(QueueEntry{cost_[t], t});
+      states_[t].context = contextFromScratch(t);
+      states_[t].cost = static_cast<float>(freshCost(t));
+      states_[t].handle = queue2_.push(QueueEntry{states_[t].cost, t});
     }
   }
 
@@ -189,7 +186,7 @@ private:
     while (!queue.empty()) {
       const CandidateIndex t = queue.top().candidate;
       queue.pop();
-      state_[t] = State::idle;
+      states_[t].state = State::idle;
       ++statistics.popped;
       decide(t, queue_state, statistics);
     }
@@ -219,7 +216,7 @@ private:
         continue;
       const auto occupants = mesh_.edgeTriangles(e);
       for (CandidateIndex u : occupants)
-        if (u != no_candidate && cost_[u] > cost_[t]) {
+        if (u != no_candidate && states_[u].cost > states_[t].cost) {
           undo(u);
           ++statistics.undone;
         }
@@ -236,7 +233,7 @@ private:
           push(t, State::queue2);
           ++statistics.demoted;
         } else {
-          state_[t] = State::dropped;
+          states_[t].state = State::dropped;
           ++statistics.rejected;
         }
         return;
@@ -244,7 +241,7 @@ private:
     }
     // 2. Vertex rules.
     if (touchesClosedVertex(t)) {
-      state_[t] = State::dropped;
+      states_[t].state = State::dropped;
       ++statistics.rejected;
       return;
     }
@@ -256,8 +253,8 @@ private:
           vertex_face_incidence = true;
       }
     }
-    if (vertex_face_incidence && incidence_delays_[t] < parameters_.max_delays) {
-      ++incidence_delays_[t];
+    if (vertex_face_incidence && states_[t].incidence_delays < parameters_.max_delays) {
+      ++states_[t].incidence_delays;
       delay(t, from, statistics);
       return;
     }
@@ -271,7 +268,7 @@ private:
   }
 
   void delay(CandidateIndex t, State from, PassStatistics &statistics) {
-    cost_[t] = static_cast<float>(freshCost(t));
+    states_[t].cost = static_cast<float>(freshCost(t));
     push(t, from);
     ++statistics.delayed;
   }
@@ -280,19 +277,21 @@ private:
   /// take only one more triangle. If one is within the tolerance, both are
   /// delayed. (Q2 members are not decided in pass 1, so they do not compete.)
   bool closeCompetitorDelayed(CandidateIndex t, State queue) {
-    if (parameters_.close_ranking_tolerance <= 0 || ranking_delays_[t] >= parameters_.max_delays)
+    if (parameters_.close_ranking_tolerance <= 0 ||
+        states_[t].ranking_delays >= parameters_.max_delays)
       return false;
-    const double tolerance = parameters_.close_ranking_tolerance * cost_[t];
+    const double tolerance = parameters_.close_ranking_tolerance * states_[t].cost;
     for (EdgeIndex e : candidates_[t].edges) {
       if (mesh_.edgeTriangleCount(e) != 1)
         continue;
       for (const CandidateIndex *s = scaffold_.edgeBegin(e); s != scaffold_.edgeEnd(e); ++s) {
-        if (*s == t || state_[*s] != queue || ranking_delays_[*s] >= parameters_.max_delays)
+        if (*s == t || states_[*s].state != queue ||
+            states_[*s].ranking_delays >= parameters_.max_delays)
           continue;
-        if (std::abs(cost_[*s] - cost_[t]) <= tolerance) {
-          ++ranking_delays_[*s];
+        if (std::abs(states_[*s].cost - states_[t].cost) <= tolerance) {
+          ++states_[*s].ranking_delays;
           refreshCost(*s);
-          ++ranking_delays_[t];
+          ++states_[t].ranking_delays;
           return true;
         }
       }
@@ -302,7 +301,7 @@ private:
 
   void accept(CandidateIndex t, bool created_second_fan) {
     mesh_.add(t);
-    state_[t] = State::accepted;
+    states_[t].state = State::accepted;
     propagateContext(t, +1.0);
     for (VertexIndex v : candidates_[t].vertices) {
       if (created_second_fan && mesh_.edgeTriangleCount(mesh_.edgesAt(t, v)[0]) == 1 &&
@@ -357,9 +356,9 @@ private:
   void undo(CandidateIndex t) {
     removeFromMesh(t);
     propagateContext(t, -1.0);
-    cost_[t] = static_cast<float>(freshCost(t));
-    if (++undos_[t] > max_undos) {
-      state_[t] = State::dropped;
+    states_[t].cost = static_cast<float>(freshCost(t));
+    if (++states_[t].undos > max_undos) {
+      states_[t].state = State::dropped;
       return;
     }
     push(t, State::queue2);
@@ -440,8 +439,8 @@ private:
         continue;
       const CandidateIndex abd = candidateWith(edgeBetween(first, a, b), d);
       const CandidateIndex bcd = candidateWith(edgeBetween(first, b, c), d);
-      if (abd == no_candidate || bcd == no_candidate || state_[abd] == State::accepted ||
-          state_[bcd] == State::accepted)
+      if (abd == no_candidate || bcd == no_candidate || states_[abd].state == State::accepted ||
+          states_[bcd].state == State::accepted)
         continue;
       if (mesh_.edgeTriangleCount(edgeBetween(abd, b, d)) != 0)
         continue;
@@ -452,13 +451,13 @@ private:
       for (CandidateIndex old : {first, second}) {
         removeFromMesh(old);
         propagateContext(old, -1.0);
-        state_[old] = State::dropped;
+        states_[old].state = State::dropped;
       }
       for (CandidateIndex replacement : {abd, bcd}) {
         if (isQueued(replacement))
-          queueOf(state_[replacement]).erase(handles_[replacement]);
+          queueOf(states_[replacement].state).erase(states_[replacement].handle);
         mesh_.add(replacement);
-        state_[replacement] = State::accepted;
+        states_[replacement].state = State::accepted;
         propagateContext(replacement, +1.0);
         for (EdgeIndex outer : candidates_[replacement].edges)
           enqueue(outer);
@@ -517,7 +516,7 @@ private:
         for (CandidateIndex u : fans[f]) {
           removeFromMesh(u);
           propagateContext(u, -1.0);
-          state_[u] = State::dropped;
+          states_[u].state = State::dropped;
           ++statistics_.cleanup_undone;
           for (VertexIndex w : candidates_[u].vertices)
             if (w != v && !is_pending[w]) {
@@ -532,7 +531,7 @@ private:
   double fanCost(const std::vector<CandidateIndex> &fan) const {
     double total = 0;
     for (CandidateIndex u : fan)
-      total += cost_[u];
+      total += states_[u].cost;
     return total;
   }
 
@@ -543,11 +542,16 @@ private:
   GreedyStatistics &statistics_;
   MeshTopology mesh_;
 
-  std::vector<double> context_;
-  std::vector<float> cost_;
-  std::vector<State> state_;
-  std::vector<std::uint8_t> incidence_delays_, ranking_delays_, undos_;
-  std::vector<Queue::handle_type> handles_;
+  // Everything the greedy keeps per candidate, in one record: candidates
+  // are visited in cost order, i.e. all over memory, so one cache line each.
+  struct CandidateState {
+    double context = 0; // sum of eps2 from accepted neighbours
+    Queue::handle_type handle;
+    float cost = 0; // current cost: (base + context) clamped at 0, times delays
+    State state = State::idle;
+    std::uint8_t incidence_delays = 0, ranking_delays = 0, undos = 0;
+  };
+  std::vector<CandidateState> states_;
   std::vector<bool> multi_fan_vertex_;
   std::vector<bool> may_have_several_fans_;
   std::vector<double> delay_multiplier_;

@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <limits>
 #include <numeric>
 #include <sstream>
@@ -44,6 +46,16 @@ using Clock = std::chrono::steady_clock;
 
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// The process's peak resident set so far (VmHWM), or 0 where unknown.
+std::size_t peakResidentBytes() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line))
+    if (line.compare(0, 6, "VmHWM:") == 0)
+      return static_cast<std::size_t>(std::strtoull(line.c_str() + 6, nullptr, 10)) * 1024;
+  return 0;
 }
 
 /// The distinct, finite points of the user's records, centred on their
@@ -153,6 +165,7 @@ Result reconstruct(const PointView &points, const Parameters &parameters) {
   Clock::time_point stage = Clock::now();
   const PreparedPoints prepared = preparePoints(points, parameters.use_normals, result);
   result.timings.prepare = secondsSince(stage);
+  result.peak_memory.prepare = peakResidentBytes();
 
   stage = Clock::now();
   ScaffoldOptions options;
@@ -170,6 +183,7 @@ Result reconstruct(const PointView &points, const Parameters &parameters) {
   result.candidates_type2 = scaffold.type2;
   result.candidates_type3 = scaffold.type3;
   result.candidates_oversize = scaffold.oversize;
+  result.peak_memory.scaffold = peakResidentBytes();
 
   stage = Clock::now();
   std::vector<Triangle> triangles;
@@ -183,6 +197,7 @@ Result reconstruct(const PointView &points, const Parameters &parameters) {
     result.swapped_pairs = mesher.statistics().swapped_pairs;
   }
   result.timings.greedy = secondsSince(stage);
+  result.peak_memory.greedy = peakResidentBytes();
 
   stage = Clock::now();
   FinishedSurface surface = finishSurface(std::move(triangles), prepared.positions,
@@ -200,6 +215,7 @@ Result reconstruct(const PointView &points, const Parameters &parameters) {
   result.component_orientable = std::move(surface.component_orientable);
   result.holes_filled = surface.holes_filled;
   result.timings.finish = secondsSince(stage);
+  result.peak_memory.finish = peakResidentBytes();
   result.timings.total = secondsSince(start);
   return result;
 }

@@ -72,6 +72,12 @@ TEST(Bunny, RecoversTheReferenceSurface) {
   const Meshed &bunny = bunnyAtDefaults();
   ASSERT_TRUE(bunny.error.empty()) << bunny.error;
   EXPECT_EQ(bunny.mesh.cloud.width * bunny.mesh.cloud.height, 35947u);
+  // Stage peaks are a running maximum of the process's resident memory.
+  const pcl_ms::StagePeakMemory &memory = bunny.result.peak_memory;
+  EXPECT_GT(memory.prepare, 0u);
+  EXPECT_LE(memory.prepare, memory.scaffold);
+  EXPECT_LE(memory.scaffold, memory.greedy);
+  EXPECT_LE(memory.greedy, memory.finish);
 
   const ReferenceMesh &reference = bunnyReference();
   const std::vector<Eigen::Vector3d> vertices = positions(*loadXYZ("bunny.pcd"));

@@ -78,6 +78,16 @@ struct StageTimings {
   double total = 0;
 };
 
+/// The process's peak resident memory (bytes) when each stage ended, so the
+/// growth from one to the next is what that stage needed at most. 0 where
+/// the platform does not report it (read from /proc on Linux).
+struct StagePeakMemory {
+  std::size_t prepare = 0;
+  std::size_t scaffold = 0; // Delaunay structure and candidates
+  std::size_t greedy = 0;
+  std::size_t finish = 0;
+};
+
 /// Everything the core reports after a run. Indices refer to the user's
 /// records (PointView::xyz), never to a filtered copy.
 struct Result {
@@ -103,6 +113,7 @@ struct Result {
   std::size_t swapped_pairs = 0;  // non-Delaunay quads re-triangulated
   std::size_t holes_filled = 0;
   StageTimings timings;
+  StagePeakMemory peak_memory;
 
   std::size_t numberOfComponents() const { return component_orientable.size(); }
   std::size_t numberOfNonOrientableComponents() const;
