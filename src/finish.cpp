@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <numeric>
 #include <queue>
 #include <set>
 
@@ -15,6 +16,14 @@ namespace pcl_ms {
 namespace {
 
 using EdgeKey = std::uint64_t;
+
+// A component that cannot be oriented is cut only where its inconsistent
+// edges bend by more than this (90 degrees): a crumpled spot, not the gentle
+// twist of a real Moebius band, which is kept and reported.
+constexpr double max_untwist_bending = M_PI / 2;
+constexpr int max_untwist_rounds = 3;
+// Loops opened by removing a twisted fan are closed again up to this size.
+constexpr int max_untwist_loop_edges = 16;
 
 EdgeKey edgeKey(VertexIndex a, VertexIndex b) {
   if (a > b)
@@ -198,10 +207,24 @@ std::vector<std::vector<VertexIndex>> traceBoundaryLoops(const std::vector<Trian
 }
 
 std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen::Vector3d> &points,
-                      int max_edges, double max_side) {
+                      int max_edges, double max_side, const std::vector<bool> *only_around) {
   if (max_edges < 3)
     return 0;
-  const auto loops = traceBoundaryLoops(triangles);
+  auto loops = traceBoundaryLoops(triangles);
+  // Only simple loops: a vertex met twice is a pinch the polygon DP cannot
+  // fill; with only_around, only loops that reach the marked vertices.
+  loops.erase(std::remove_if(loops.begin(), loops.end(),
+                             [&](const std::vector<VertexIndex> &loop) {
+                               std::vector<VertexIndex> sorted = loop;
+                               std::sort(sorted.begin(), sorted.end());
+                               if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
+                                 return true;
+                               return only_around &&
+                                      std::none_of(loop.begin(), loop.end(), [&](VertexIndex v) {
+                                        return (*only_around)[v];
+                                      });
+                             }),
+              loops.end());
   const bool any_small_loop = std::any_of(loops.begin(), loops.end(), [&](const auto &loop) {
     return loop.size() <= static_cast<std::size_t>(max_edges);
   });
@@ -249,84 +272,267 @@ std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen:
   return filled;
 }
 
-void orientComponents(std::vector<Triangle> &triangles, const std::vector<Eigen::Vector3d> &points,
-                      std::vector<std::uint32_t> &triangle_component,
-                      std::vector<bool> &component_orientable) {
-  const std::uint32_t unvisited = std::numeric_limits<std::uint32_t>::max();
+namespace {
+
+/// Two triangles sharing a manifold edge, and how much the surface bends there.
+struct ManifoldPair {
+  std::uint32_t first, second;
+  double bending;
+};
+
+std::vector<ManifoldPair> manifoldPairs(const std::vector<Triangle> &triangles,
+                                        const std::vector<Eigen::Vector3d> &points) {
   const std::vector<EdgeUse> uses = edgeUses(triangles);
-  // Neighbours across manifold edges (exactly two triangles), as a CSR.
-  std::vector<std::uint32_t> offsets(triangles.size() + 1, 0);
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
-  forEachEdge(uses, [&](EdgeKey, std::size_t first, std::size_t count) {
-    if (count == 2)
-      pairs.emplace_back(uses[first].triangle, uses[first + 1].triangle);
+  std::vector<ManifoldPair> pairs;
+  forEachEdge(uses, [&](EdgeKey key, std::size_t first, std::size_t count) {
+    if (count != 2)
+      return;
+    const VertexIndex a = lowVertex(key), b = highVertex(key);
+    auto apex = [&](std::uint32_t t) {
+      for (VertexIndex v : triangles[t])
+        if (v != a && v != b)
+          return v;
+      return a;
+    };
+    const std::uint32_t t = uses[first].triangle, u = uses[first + 1].triangle;
+    pairs.push_back({t, u, bendingAngle(points[a], points[b], points[apex(t)], points[apex(u)])});
   });
-  for (const auto &[a, b] : pairs) {
-    ++offsets[a + 1];
-    ++offsets[b + 1];
+  return pairs;
+}
+
+/// Whether t and u run their shared edge in opposite directions.
+bool consistentlyOriented(const Triangle &t, const Triangle &u) {
+  for (int k = 0; k < 3; ++k)
+    if (runsFromTo(u, t[(k + 1) % 3], t[k]))
+      return true;
+  return false;
+}
+
+/// The triangles at each vertex.
+std::vector<std::vector<std::uint32_t>> vertexFans(const std::vector<Triangle> &triangles,
+                                                   std::size_t vertex_count) {
+  std::vector<std::vector<std::uint32_t>> at(vertex_count);
+  for (std::uint32_t t = 0; t < triangles.size(); ++t)
+    for (VertexIndex v : triangles[t])
+      at[v].push_back(t);
+  return at;
+}
+
+/// The triangles at v (given in `around`) grouped into fans joined by edges at v.
+std::vector<std::vector<std::uint32_t>> fansAt(VertexIndex v,
+                                               const std::vector<std::uint32_t> &around,
+                                               const std::vector<Triangle> &triangles) {
+  std::vector<std::size_t> parent(around.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](std::size_t i) {
+    while (parent[i] != i)
+      i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  auto otherCorners = [&](std::uint32_t t) {
+    std::array<VertexIndex, 2> corners{};
+    int n = 0;
+    for (VertexIndex w : triangles[t])
+      if (w != v && n < 2)
+        corners[n++] = w;
+    return corners;
+  };
+  for (std::size_t i = 0; i < around.size(); ++i)
+    for (std::size_t j = i + 1; j < around.size(); ++j) {
+      const auto a = otherCorners(around[i]), b = otherCorners(around[j]);
+      if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1])
+        parent[find(i)] = find(j);
+    }
+  std::vector<std::vector<std::uint32_t>> fans;
+  std::vector<std::size_t> fan_of_root(around.size(), around.size());
+  for (std::size_t i = 0; i < around.size(); ++i) {
+    const std::size_t root = find(i);
+    if (fan_of_root[root] == around.size()) {
+      fan_of_root[root] = fans.size();
+      fans.emplace_back();
+    }
+    fans[fan_of_root[root]].push_back(around[i]);
+  }
+  return fans;
+}
+
+/// How far the triangles of a fan disagree: 1 minus the smallest |cosine|
+/// between a triangle's normal and their mean (orientation ignored).
+double fanSpread(const std::vector<std::uint32_t> &fan, const std::vector<Triangle> &triangles,
+                 const std::vector<Eigen::Vector3d> &points) {
+  std::vector<Eigen::Vector3d> normals;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (std::uint32_t t : fan) {
+    const Triangle &f = triangles[t];
+    Eigen::Vector3d normal = (points[f[1]] - points[f[0]]).cross(points[f[2]] - points[f[0]]);
+    if (normal.squaredNorm() == 0)
+      continue;
+    normal.normalize();
+    if (!normals.empty() && normal.dot(normals.front()) < 0)
+      normal = -normal;
+    normals.push_back(normal);
+    mean += normal;
+  }
+  if (normals.empty() || mean.squaredNorm() == 0)
+    return 2;
+  mean.normalize();
+  double smallest = 1;
+  for (const Eigen::Vector3d &normal : normals)
+    smallest = std::min(smallest, std::abs(normal.dot(mean)));
+  return 1 - smallest;
+}
+
+/// Drops the marked triangles; their corners are marked in touched.
+void dropTriangles(std::vector<Triangle> &triangles, const std::vector<bool> &drop,
+                   std::vector<bool> &touched) {
+  std::size_t write = 0;
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    if (drop[t])
+      for (VertexIndex v : triangles[t])
+        touched[v] = true;
+    else
+      triangles[write++] = triangles[t];
+  }
+  triangles.resize(write);
+}
+
+/// Keeps one fan (the largest) at every touched vertex with several, until
+/// no touched vertex has more than one.
+void splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_count,
+                  std::vector<bool> &touched) {
+  for (bool changed = true; changed;) {
+    changed = false;
+    const auto at = vertexFans(triangles, vertex_count);
+    std::vector<bool> drop(triangles.size(), false);
+    for (VertexIndex v = 0; v < vertex_count; ++v) {
+      if (!touched[v] || at[v].size() < 2)
+        continue;
+      const auto fans = fansAt(v, at[v], triangles);
+      if (fans.size() < 2)
+        continue;
+      std::size_t keep = 0;
+      for (std::size_t f = 1; f < fans.size(); ++f)
+        if (fans[f].size() > fans[keep].size())
+          keep = f;
+      for (std::size_t f = 0; f < fans.size(); ++f)
+        if (f != keep)
+          for (std::uint32_t t : fans[f])
+            drop[t] = changed = true;
+    }
+    if (changed)
+      dropTriangles(triangles, drop, touched);
+  }
+}
+
+} // namespace
+
+std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
+                                            const std::vector<Eigen::Vector3d> &points,
+                                            std::vector<std::uint32_t> &triangle_component,
+                                            std::vector<bool> &component_orientable) {
+  const std::uint32_t unvisited = std::numeric_limits<std::uint32_t>::max();
+  const std::vector<ManifoldPair> pairs = manifoldPairs(triangles, points);
+  std::vector<std::uint32_t> offsets(triangles.size() + 1, 0);
+  for (const ManifoldPair &pair : pairs) {
+    ++offsets[pair.first + 1];
+    ++offsets[pair.second + 1];
   }
   for (std::size_t t = 0; t < triangles.size(); ++t)
     offsets[t + 1] += offsets[t];
-  std::vector<std::uint32_t> neighbours(offsets.back());
+  std::vector<std::uint32_t> incident(offsets.back());
   {
     std::vector<std::uint32_t> cursor(offsets.begin(), offsets.end() - 1);
-    for (const auto &[a, b] : pairs) {
-      neighbours[cursor[a]++] = b;
-      neighbours[cursor[b]++] = a;
+    for (std::uint32_t p = 0; p < pairs.size(); ++p) {
+      incident[cursor[pairs[p].first]++] = p;
+      incident[cursor[pairs[p].second]++] = p;
     }
   }
 
+  // Orientation spreads across the flattest edges first (a maximum spanning
+  // tree on flatness): where a component cannot be oriented, the edges left
+  // inconsistent are then its most bent ones, i.e. where the twist is.
+  using Step = std::pair<double, std::uint32_t>; // bending, pair index
+  std::priority_queue<Step, std::vector<Step>, std::greater<Step>> frontier;
   triangle_component.assign(triangles.size(), unvisited);
   component_orientable.clear();
-  std::vector<std::uint32_t> members;
+  std::vector<std::vector<std::uint32_t>> members;
+  auto spreadFrom = [&](std::uint32_t t) {
+    for (std::uint32_t i = offsets[t]; i < offsets[t + 1]; ++i)
+      frontier.push({pairs[incident[i]].bending, incident[i]});
+  };
   for (std::uint32_t seed = 0; seed < triangles.size(); ++seed) {
     if (triangle_component[seed] != unvisited)
       continue;
     const std::uint32_t component = static_cast<std::uint32_t>(component_orientable.size());
-    bool orientable = true;
-    members.clear();
-    std::queue<std::uint32_t> frontier;
-    frontier.push(seed);
+    component_orientable.push_back(true);
+    members.push_back({seed});
     triangle_component[seed] = component;
+    spreadFrom(seed);
     while (!frontier.empty()) {
-      const std::uint32_t t = frontier.front();
+      const ManifoldPair &pair = pairs[frontier.top().second];
       frontier.pop();
-      members.push_back(t);
-      for (std::uint32_t i = offsets[t]; i < offsets[t + 1]; ++i) {
-        const std::uint32_t u = neighbours[i];
-        // The shared edge must run in opposite directions in t and u.
-        VertexIndex a = 0, b = 0;
-        for (int k = 0; k < 3; ++k) {
-          const VertexIndex from = triangles[t][k], to = triangles[t][(k + 1) % 3];
-          if (std::count(triangles[u].begin(), triangles[u].end(), from) &&
-              std::count(triangles[u].begin(), triangles[u].end(), to)) {
-            a = from;
-            b = to;
-          }
-        }
-        const bool consistent = runsFromTo(triangles[u], b, a);
-        if (triangle_component[u] == unvisited) {
-          if (!consistent)
-            std::swap(triangles[u][1], triangles[u][2]);
-          triangle_component[u] = component;
-          frontier.push(u);
-        } else if (!consistent) {
-          orientable = false;
-        }
+      const bool first_known = triangle_component[pair.first] != unvisited;
+      const bool second_known = triangle_component[pair.second] != unvisited;
+      if (first_known && second_known)
+        continue;
+      const std::uint32_t known = first_known ? pair.first : pair.second;
+      const std::uint32_t next = first_known ? pair.second : pair.first;
+      if (!consistentlyOriented(triangles[known], triangles[next]))
+        std::swap(triangles[next][1], triangles[next][2]);
+      triangle_component[next] = component;
+      members.back().push_back(next);
+      spreadFrom(next);
+    }
+  }
+  std::vector<std::uint32_t> sharply_bent_conflicts;
+  for (const ManifoldPair &pair : pairs)
+    if (!consistentlyOriented(triangles[pair.first], triangles[pair.second])) {
+      component_orientable[triangle_component[pair.first]] = false;
+      if (pair.bending > max_untwist_bending)
+        sharply_bent_conflicts.push_back(pair.first);
+    }
+  for (std::uint32_t component = 0; component < members.size(); ++component) {
+    if (!component_orientable[component])
+      continue;
+    // Outward for closed surfaces; a fixed, reproducible choice otherwise.
+    double signed_volume = 0;
+    for (std::uint32_t t : members[component])
+      signed_volume +=
+          points[triangles[t][0]].dot(points[triangles[t][1]].cross(points[triangles[t][2]]));
+    if (signed_volume < 0)
+      for (std::uint32_t t : members[component])
+        std::swap(triangles[t][1], triangles[t][2]);
+  }
+  return sharply_bent_conflicts;
+}
+
+std::size_t removeTwistedFans(std::vector<Triangle> &triangles,
+                              const std::vector<Eigen::Vector3d> &points,
+                              const std::vector<std::uint32_t> &twisted,
+                              std::vector<bool> &touched) {
+  touched.assign(points.size(), false);
+  const std::size_t before = triangles.size();
+  // At each twisted spot the corner whose fan is most crumpled (typically a
+  // stray point) loses its fan.
+  const auto at = vertexFans(triangles, points.size());
+  std::vector<bool> drop(triangles.size(), false);
+  for (std::uint32_t t : twisted) {
+    VertexIndex worst = triangles[t][0];
+    double worst_spread = -1;
+    for (VertexIndex v : triangles[t]) {
+      const double spread = fanSpread(at[v], triangles, points);
+      if (spread > worst_spread) {
+        worst_spread = spread;
+        worst = v;
       }
     }
-    if (orientable) {
-      // Outward for closed surfaces; a fixed, reproducible choice otherwise.
-      double signed_volume = 0;
-      for (std::uint32_t t : members)
-        signed_volume +=
-            points[triangles[t][0]].dot(points[triangles[t][1]].cross(points[triangles[t][2]]));
-      if (signed_volume < 0)
-        for (std::uint32_t t : members)
-          std::swap(triangles[t][1], triangles[t][2]);
-    }
-    component_orientable.push_back(orientable);
+    for (std::uint32_t u : at[worst])
+      drop[u] = true;
   }
+  dropTriangles(triangles, drop, touched);
+  // The ring of a dropped fan can pinch a neighbour into a bow-tie.
+  splitBowTies(triangles, points.size(), touched);
+  return before - triangles.size();
 }
 
 FinishedSurface finishSurface(std::vector<Triangle> triangles,
@@ -334,7 +540,17 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
                               double max_side) {
   FinishedSurface surface;
   surface.holes_filled = fillHoles(triangles, points, fill_holes_max_edges, max_side);
-  orientComponents(triangles, points, surface.triangle_component, surface.component_orientable);
+  std::vector<std::uint32_t> twisted =
+      orientComponents(triangles, points, surface.triangle_component, surface.component_orientable);
+  for (int round = 0; round < max_untwist_rounds && !twisted.empty(); ++round) {
+    std::vector<bool> touched;
+    surface.twist_triangles_removed += removeTwistedFans(triangles, points, twisted, touched);
+    // The loops that removal opened are ours to close, whatever the user's limit.
+    surface.holes_filled +=
+        fillHoles(triangles, points, max_untwist_loop_edges, max_side, &touched);
+    twisted = orientComponents(triangles, points, surface.triangle_component,
+                               surface.component_orientable);
+  }
   surface.boundary_loops = traceBoundaryLoops(triangles);
   surface.triangles = std::move(triangles);
   return surface;

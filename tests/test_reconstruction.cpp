@@ -84,6 +84,10 @@ TEST(Bunny, RecoversTheReferenceSurface) {
   const MeshTopologyReport topology = pcl_ms::analyzeMesh(vertices, bunny.triangles);
   expectCleanManifold(topology);
   EXPECT_EQ(topology.components, 1u);
+  // A stray point at the base rim used to leave a crumpled, twisted fan.
+  EXPECT_TRUE(topology.orientable);
+  EXPECT_EQ(topology.inconsistently_oriented_edges, 0u);
+  EXPECT_EQ(bunny.result.numberOfNonOrientableComponents(), 0u);
   // At the default rho the base keeps its larger openings (the reference has 5).
   EXPECT_LE(topology.boundary_loops, 5u);
 

@@ -275,6 +275,35 @@ TEST(Finish, OrientsClosedSurfacesOutward) {
   }
 }
 
+TEST(Finish, GentleMoebiusBandIsKeptWhole) {
+  // A finely sampled band: its twist bends no edge sharply, so finishing
+  // must keep every triangle and report the band as non-orientable.
+  std::vector<Eigen::Vector3d> points;
+  const int segments = 60;
+  for (int i = 0; i < segments; ++i) {
+    const double angle = 2 * M_PI * i / segments, twist = angle / 2;
+    for (double side : {-0.2, 0.2}) {
+      const double r = 1 + side * std::cos(twist);
+      points.emplace_back(r * std::cos(angle), r * std::sin(angle), side * std::sin(twist));
+    }
+  }
+  std::vector<Triangle> band;
+  for (int i = 0; i < segments; ++i) {
+    const VertexIndex a = 2 * i, b = 2 * i + 1;
+    VertexIndex c = 2 * ((i + 1) % segments), d = c + 1;
+    if (i == segments - 1)
+      std::swap(c, d);
+    band.push_back({a, b, d});
+    band.push_back({a, d, c});
+  }
+  const FinishedSurface surface = finishSurface(band, points, 8, 10.0);
+  EXPECT_EQ(surface.triangles.size(), band.size());
+  EXPECT_EQ(surface.twist_triangles_removed, 0u);
+  ASSERT_EQ(surface.component_orientable.size(), 1u);
+  EXPECT_FALSE(surface.component_orientable[0]);
+  EXPECT_EQ(surface.boundary_loops.size(), 1u);
+}
+
 TEST(Finish, MoebiusStripIsReportedNonOrientable) {
   // A strip of 5 quads whose ends are glued with a half twist.
   std::vector<Eigen::Vector3d> points;

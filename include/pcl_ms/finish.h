@@ -19,6 +19,7 @@ struct FinishedSurface {
   std::vector<std::uint32_t> triangle_component;
   std::vector<bool> component_orientable;
   std::size_t holes_filled = 0;
+  std::size_t twist_triangles_removed = 0;
 };
 
 /// Cyclic boundary loops of a 2-manifold triangle list, each starting at its
@@ -28,16 +29,31 @@ std::vector<std::vector<VertexIndex>> traceBoundaryLoops(const std::vector<Trian
 /// Closes loops of at most max_edges edges with triangles of the Delaunay
 /// triangulation of the loop's vertices (minimum total P / C^2, no edge
 /// that the mesh already has inside the hole, sides below max_side except
-/// for a triangular hole). Returns the holes closed.
+/// for a triangular hole). Only simple loops; with only_around, only loops
+/// through a vertex marked there. Returns the holes closed.
 std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen::Vector3d> &points,
-                      int max_edges, double max_side);
+                      int max_edges, double max_side,
+                      const std::vector<bool> *only_around = nullptr);
 
-/// Orients every component consistently by a breadth-first walk over shared
-/// edges (outward for closed components: positive signed volume); a
-/// component where no consistent orientation exists is reported and kept.
-void orientComponents(std::vector<Triangle> &triangles, const std::vector<Eigen::Vector3d> &points,
-                      std::vector<std::uint32_t> &triangle_component,
-                      std::vector<bool> &component_orientable);
+/// Orients every component consistently, spreading across the flattest
+/// shared edges first (outward for closed components: positive signed
+/// volume); a component where no consistent orientation exists is reported
+/// and kept. Returns one triangle per inconsistent edge that bends by more
+/// than 90 degrees.
+std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
+                                            const std::vector<Eigen::Vector3d> &points,
+                                            std::vector<std::uint32_t> &triangle_component,
+                                            std::vector<bool> &component_orientable);
+
+/// At each triangle that orientComponents reported (a sharp twist, e.g. a
+/// crumpled fan around a stray point), removes the most crumpled corner's
+/// fan and splits any bow-tie this leaves, so that hole filling can close the
+/// spot again. Returns how many triangles it removed; their corners are
+/// marked in touched.
+std::size_t removeTwistedFans(std::vector<Triangle> &triangles,
+                              const std::vector<Eigen::Vector3d> &points,
+                              const std::vector<std::uint32_t> &twisted,
+                              std::vector<bool> &touched);
 
 /// All of the above in order.
 FinishedSurface finishSurface(std::vector<Triangle> triangles,
