@@ -39,6 +39,27 @@ const Candidate *findCandidate(const MedialScaffold &scaffold, Triangle vertices
   return nullptr;
 }
 
+/// A strip of `segments` quads around a circle whose ends are glued with a
+/// half twist.
+void moebiusBand(int segments, double half_width, std::vector<Eigen::Vector3d> &points,
+                 std::vector<Triangle> &triangles) {
+  for (int i = 0; i < segments; ++i) {
+    const double angle = 2 * M_PI * i / segments, twist = angle / 2;
+    for (double side : {-half_width, half_width}) {
+      const double r = 1 + side * std::cos(twist);
+      points.emplace_back(r * std::cos(angle), r * std::sin(angle), side * std::sin(twist));
+    }
+  }
+  for (int i = 0; i < segments; ++i) {
+    const VertexIndex a = 2 * i, b = 2 * i + 1;
+    VertexIndex c = 2 * ((i + 1) % segments), d = c + 1;
+    if (i == segments - 1)
+      std::swap(c, d); // the half twist
+    triangles.push_back({a, b, d});
+    triangles.push_back({a, d, c});
+  }
+}
+
 Result runOn(const std::vector<Eigen::Vector3d> &points, Parameters parameters = {}) {
   std::vector<float> xyz;
   for (const auto &p : points)
@@ -279,23 +300,8 @@ TEST(Finish, GentleMoebiusBandIsKeptWhole) {
   // A finely sampled band: its twist bends no edge sharply, so finishing
   // must keep every triangle and report the band as non-orientable.
   std::vector<Eigen::Vector3d> points;
-  const int segments = 60;
-  for (int i = 0; i < segments; ++i) {
-    const double angle = 2 * M_PI * i / segments, twist = angle / 2;
-    for (double side : {-0.2, 0.2}) {
-      const double r = 1 + side * std::cos(twist);
-      points.emplace_back(r * std::cos(angle), r * std::sin(angle), side * std::sin(twist));
-    }
-  }
   std::vector<Triangle> band;
-  for (int i = 0; i < segments; ++i) {
-    const VertexIndex a = 2 * i, b = 2 * i + 1;
-    VertexIndex c = 2 * ((i + 1) % segments), d = c + 1;
-    if (i == segments - 1)
-      std::swap(c, d);
-    band.push_back({a, b, d});
-    band.push_back({a, d, c});
-  }
+  moebiusBand(60, 0.2, points, band);
   const FinishedSurface surface = finishSurface(band, points, 8, 10.0);
   EXPECT_EQ(surface.triangles.size(), band.size());
   EXPECT_EQ(surface.twist_triangles_removed, 0u);
@@ -305,25 +311,9 @@ TEST(Finish, GentleMoebiusBandIsKeptWhole) {
 }
 
 TEST(Finish, MoebiusStripIsReportedNonOrientable) {
-  // A strip of 5 quads whose ends are glued with a half twist.
   std::vector<Eigen::Vector3d> points;
-  const int segments = 5;
-  for (int i = 0; i < segments; ++i) {
-    const double angle = 2 * M_PI * i / segments, twist = angle / 2;
-    for (double side : {-0.3, 0.3}) {
-      const double r = 1 + side * std::cos(twist);
-      points.emplace_back(r * std::cos(angle), r * std::sin(angle), side * std::sin(twist));
-    }
-  }
   std::vector<Triangle> strip;
-  for (int i = 0; i < segments; ++i) {
-    const VertexIndex a = 2 * i, b = 2 * i + 1;
-    VertexIndex c = 2 * ((i + 1) % segments), d = c + 1;
-    if (i == segments - 1)
-      std::swap(c, d); // the half twist
-    strip.push_back({a, b, d});
-    strip.push_back({a, d, c});
-  }
+  moebiusBand(5, 0.3, points, strip);
   std::vector<std::uint32_t> component;
   std::vector<bool> orientable;
   orientComponents(strip, points, component, orientable);
