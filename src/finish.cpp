@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include <pcl_ms/costs.h>
 #include <pcl_ms/finish.h>
+#include <pcl_ms/mesh_topology.h>
 
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -8,7 +9,6 @@
 
 #include <algorithm>
 #include <limits>
-#include <numeric>
 #include <queue>
 #include <set>
 
@@ -322,13 +322,6 @@ std::vector<std::vector<std::uint32_t>> vertexFans(const std::vector<Triangle> &
 std::vector<std::vector<std::uint32_t>> fansAt(VertexIndex v,
                                                const std::vector<std::uint32_t> &around,
                                                const std::vector<Triangle> &triangles) {
-  std::vector<std::size_t> parent(around.size());
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](std::size_t i) {
-    while (parent[i] != i)
-      i = parent[i] = parent[parent[i]];
-    return i;
-  };
   auto otherCorners = [&](std::uint32_t t) {
     std::array<VertexIndex, 2> corners{};
     int n = 0;
@@ -337,22 +330,19 @@ std::vector<std::vector<std::uint32_t>> fansAt(VertexIndex v,
         corners[n++] = w;
     return corners;
   };
-  for (std::size_t i = 0; i < around.size(); ++i)
-    for (std::size_t j = i + 1; j < around.size(); ++j) {
-      const auto a = otherCorners(around[i]), b = otherCorners(around[j]);
-      if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1])
-        parent[find(i)] = find(j);
-    }
-  std::vector<std::vector<std::uint32_t>> fans;
-  std::vector<std::size_t> fan_of_root(around.size(), around.size());
-  for (std::size_t i = 0; i < around.size(); ++i) {
-    const std::size_t root = find(i);
-    if (fan_of_root[root] == around.size()) {
-      fan_of_root[root] = fans.size();
-      fans.emplace_back();
-    }
-    fans[fan_of_root[root]].push_back(around[i]);
-  }
+  // Two triangles at v are in one fan when they share a second corner.
+  const auto groups = connectedGroups(around.size(), [&](const auto &join) {
+    for (std::size_t i = 0; i < around.size(); ++i)
+      for (std::size_t j = i + 1; j < around.size(); ++j) {
+        const auto a = otherCorners(around[i]), b = otherCorners(around[j]);
+        if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1])
+          join(i, j);
+      }
+  });
+  std::vector<std::vector<std::uint32_t>> fans(groups.size());
+  for (std::size_t f = 0; f < groups.size(); ++f)
+    for (std::size_t i : groups[f])
+      fans[f].push_back(around[i]);
   return fans;
 }
 

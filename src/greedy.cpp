@@ -69,8 +69,6 @@ public:
     enforceManifoldVertices();
   }
 
-  const MeshTopology &mesh() const { return mesh_; }
-
   std::vector<Triangle> triangles() const {
     std::vector<Triangle> result;
     result.reserve(mesh_.size());
@@ -336,10 +334,12 @@ private:
     multi_fan_vertex_[v] = false;
   }
 
-  /// Removing a triangle from the middle of a fan splits it in two: its
-  /// corners are checked again by the final manifold sweep.
+  /// Takes t out of the mesh together with the context it gave its
+  /// neighbours. Removing a triangle from the middle of a fan splits it in
+  /// two: its corners are checked again by the final manifold sweep.
   void removeFromMesh(CandidateIndex t) {
     mesh_.remove(t);
+    propagateContext(t, -1.0);
     for (VertexIndex v : candidates_[t].vertices)
       may_have_several_fans_[v] = true;
   }
@@ -355,7 +355,6 @@ private:
   /// Takes t out of the mesh and sends it to Q2 with a fresh cost.
   void undo(CandidateIndex t) {
     removeFromMesh(t);
-    propagateContext(t, -1.0);
     states_[t].cost = static_cast<float>(freshCost(t));
     if (++states_[t].undos > max_undos) {
       states_[t].state = State::dropped;
@@ -450,7 +449,6 @@ private:
         continue;
       for (CandidateIndex old : {first, second}) {
         removeFromMesh(old);
-        propagateContext(old, -1.0);
         states_[old].state = State::dropped;
       }
       for (CandidateIndex replacement : {abd, bcd}) {
@@ -515,7 +513,6 @@ private:
           continue;
         for (CandidateIndex u : fans[f]) {
           removeFromMesh(u);
-          propagateContext(u, -1.0);
           states_[u].state = State::dropped;
           ++statistics_.cleanup_undone;
           for (VertexIndex w : candidates_[u].vertices)
@@ -568,7 +565,5 @@ GreedyMesher::~GreedyMesher() = default;
 void GreedyMesher::run() { impl_->run(); }
 
 std::vector<Triangle> GreedyMesher::triangles() const { return impl_->triangles(); }
-
-const MeshTopology &GreedyMesher::mesh() const { return impl_->mesh(); }
 
 } // namespace pcl_ms

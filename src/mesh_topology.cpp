@@ -2,7 +2,6 @@
 #include <pcl_ms/mesh_topology.h>
 
 #include <algorithm>
-#include <numeric>
 
 namespace pcl_ms {
 
@@ -58,34 +57,19 @@ void MeshTopology::remove(CandidateIndex t) {
 std::vector<std::vector<CandidateIndex>> MeshTopology::fansAround(VertexIndex v) const {
   std::vector<CandidateIndex> triangles = vertex_triangles_[v];
   std::sort(triangles.begin(), triangles.end());
-  const std::size_t count = triangles.size();
-  // Union-find over the few triangles at v, joined through shared edges at v.
-  std::vector<std::size_t> parent(count);
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](std::size_t i) {
-    while (parent[i] != i)
-      i = parent[i] = parent[parent[i]];
-    return i;
-  };
-  for (std::size_t i = 0; i < count; ++i)
-    for (EdgeIndex e : edgesAt(triangles[i], v)) {
-      const CandidateIndex other = otherTriangle(e, triangles[i]);
-      if (other == no_candidate)
-        continue;
-      const std::size_t j =
-          std::lower_bound(triangles.begin(), triangles.end(), other) - triangles.begin();
-      parent[find(i)] = find(j);
-    }
-  std::vector<std::vector<CandidateIndex>> fans;
-  std::vector<std::size_t> fan_of_root(count, count);
-  for (std::size_t i = 0; i < count; ++i) {
-    const std::size_t root = find(i);
-    if (fan_of_root[root] == count) {
-      fan_of_root[root] = fans.size();
-      fans.emplace_back();
-    }
-    fans[fan_of_root[root]].push_back(triangles[i]);
-  }
+  // Triangles at v are joined through the edges they share at v.
+  const auto groups = connectedGroups(triangles.size(), [&](const auto &join) {
+    for (std::size_t i = 0; i < triangles.size(); ++i)
+      for (EdgeIndex e : edgesAt(triangles[i], v)) {
+        const CandidateIndex other = otherTriangle(e, triangles[i]);
+        if (other != no_candidate)
+          join(i, std::lower_bound(triangles.begin(), triangles.end(), other) - triangles.begin());
+      }
+  });
+  std::vector<std::vector<CandidateIndex>> fans(groups.size());
+  for (std::size_t f = 0; f < groups.size(); ++f)
+    for (std::size_t i : groups[f])
+      fans[f].push_back(triangles[i]);
   return fans;
 }
 

@@ -39,7 +39,6 @@ public:
   /// Accepted triangles as distinct-point indices, in candidate order.
   std::vector<Triangle> triangles() const;
   const GreedyStatistics &statistics() const { return statistics_; }
-  const MeshTopology &mesh() const;
 
 private:
   class Impl;

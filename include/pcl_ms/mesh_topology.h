@@ -14,6 +14,34 @@ namespace pcl_ms {
 
 constexpr CandidateIndex no_candidate = std::numeric_limits<CandidateIndex>::max();
 
+/// Groups items 0..count-1 into connected sets by union-find; joins(join)
+/// calls join(i, j) for every pair known to be connected. Groups come in
+/// order of their smallest item, each ascending. Used to split the few
+/// triangles around a vertex into fans.
+template <typename Joins>
+std::vector<std::vector<std::size_t>> connectedGroups(std::size_t count, const Joins &joins) {
+  std::vector<std::size_t> parent(count);
+  for (std::size_t i = 0; i < count; ++i)
+    parent[i] = i;
+  auto find = [&](std::size_t i) {
+    while (parent[i] != i)
+      i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  joins([&](std::size_t i, std::size_t j) { parent[find(i)] = find(j); });
+  std::vector<std::vector<std::size_t>> groups;
+  std::vector<std::size_t> group_of_root(count, count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::size_t root = find(i);
+    if (group_of_root[root] == count) {
+      group_of_root[root] = groups.size();
+      groups.emplace_back();
+    }
+    groups[group_of_root[root]].push_back(i);
+  }
+  return groups;
+}
+
 class MeshTopology {
 public:
   MeshTopology(const MedialScaffold &scaffold, std::size_t vertex_count);
@@ -52,7 +80,6 @@ public:
   std::array<EdgeIndex, 2> edgesAt(CandidateIndex t, VertexIndex v) const;
 
   std::size_t size() const { return triangle_count_; }
-  const MedialScaffold &scaffold() const { return scaffold_; }
 
 private:
   const MedialScaffold &scaffold_;
