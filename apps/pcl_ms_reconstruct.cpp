@@ -3,6 +3,7 @@
 // pcl::MedialScaffoldReconstruction and saves the mesh, in the manner of
 // PCL's own command-line tools. On any failure it prints exactly one line,
 // "error: <reason>", on stderr and exits non-zero, so scripts can rely on it.
+#include <pcl_ms/buckets.h>
 #include <pcl_ms/io.h>
 #include <pcl_ms/medial_scaffold_reconstruction.h>
 
@@ -13,6 +14,7 @@
 #include <pcl/point_types.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -35,6 +37,8 @@ struct Options {
   int fill_holes = pcl_ms::Parameters().fill_holes_max_edges;
   bool normals = false;
   int threads = 1;
+  unsigned int bucket_points = 0; // 0: automatic
+  int grid = 0;
   bool quiet = false;
   bool help = false;
 };
@@ -57,6 +61,13 @@ void printHelp(const char *program) {
   print_info("  -threads N      threads for the parallel stages, 0 = all cores (default ");
   print_value("1");
   print_info(")\n");
+  print_info("  -bucket_points M  mesh clouds larger than M points in buckets of about M points,\n"
+             "                  stitched together; 0 = automatic: buckets of ");
+  print_value("%zu", pcl_ms::default_bucket_points);
+  print_info(" above ");
+  print_value("%zu", pcl_ms::automatic_bucketing_threshold);
+  print_info(" points (default 0)\n");
+  print_info("  -grid N         cut the bounding box into N x N x N buckets instead\n");
   print_info("  -q              quiet: print nothing but errors\n");
   print_info("  -h              this help\n\n");
   print_info("Exit status: 0 success, 1 bad arguments, 2 file error, 3 reconstruction failed.\n");
@@ -65,7 +76,8 @@ void printHelp(const char *program) {
 /// Collects the two file names and checks every option and its value.
 /// Numbers are read with PCL's parser, which rejects trailing garbage.
 bool parseArguments(int argc, char **argv, Options &options, std::string &error) {
-  const std::vector<std::string> value_options = {"-rho", "-fill_holes", "-threads"};
+  const std::vector<std::string> value_options = {"-rho", "-fill_holes", "-threads",
+                                                  "-bucket_points", "-grid"};
   std::vector<std::string> positional;
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
@@ -106,6 +118,12 @@ bool parseArguments(int argc, char **argv, Options &options, std::string &error)
   if (pcl::console::find_argument(argc, argv, "-threads") >= 0 &&
       pcl::console::parse_argument(argc, argv, "-threads", options.threads) < 0)
     return badValue("-threads");
+  if (pcl::console::find_argument(argc, argv, "-bucket_points") >= 0 &&
+      pcl::console::parse_argument(argc, argv, "-bucket_points", options.bucket_points) < 0)
+    return badValue("-bucket_points");
+  if (pcl::console::find_argument(argc, argv, "-grid") >= 0 &&
+      pcl::console::parse_argument(argc, argv, "-grid", options.grid) < 0)
+    return badValue("-grid");
 
   if (positional.size() != 2) {
     error = "expected input and output file names, got " + std::to_string(positional.size()) +
@@ -219,7 +237,38 @@ void printReport(const pcl_ms::Result &result, double load_ms, double save_ms) {
   printRow("d_max", "%10.6g", result.d_max);
   if (result.planar)
     print_info("  (all points lie on one plane: a 2-D Delaunay triangulation was used)\n");
+  const pcl_ms::BucketStatistics &buckets = result.bucket_statistics;
+  if (buckets.buckets > 0) {
+    printRow("buckets", "%10.0f", static_cast<double>(buckets.buckets));
+    printRow("margin points", "%10.0f", static_cast<double>(buckets.margin_points));
+    printRow("seam zones", "%10.0f", static_cast<double>(buckets.seam_zones));
+    printRow("seam points", "%10.0f", static_cast<double>(buckets.seam_points));
+    printRow("seam triangles", "%10.0f", static_cast<double>(buckets.seam_triangles));
+    printRow("buckets (wall ms)", "%10.1f", buckets.buckets_seconds * 1e3);
+    printRow("seams (wall ms)", "%10.1f", buckets.seams_seconds * 1e3);
+    if (buckets.failed_units > 0)
+      printRow("units left empty", "%10.0f", static_cast<double>(buckets.failed_units));
+  }
 }
+
+/// Buckets and seams done, elapsed time and a linear estimate of the rest,
+/// rewritten in place on stderr.
+class ProgressLine {
+public:
+  void operator()(std::size_t done, std::size_t total) const {
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double left = done > 0 ? elapsed * static_cast<double>(total - done) / done : 0;
+    std::fprintf(stderr, "\r  buckets and seams %zu/%zu, %.1f s elapsed, about %.0f s left   ",
+                 done, total, elapsed, left);
+    if (done == total)
+      std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  }
+
+private:
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
 
 int fail(ExitCode code, const std::string &reason) {
   std::fflush(stdout);
@@ -242,6 +291,8 @@ int run(int argc, char **argv) {
   parameters.fill_holes_max_edges = options.fill_holes;
   parameters.use_normals = options.normals;
   parameters.num_threads = options.threads;
+  parameters.bucket_points = options.bucket_points;
+  parameters.grid_buckets = options.grid;
   if (const std::string reason = parameters.validate(); !reason.empty())
     return fail(kBadArguments, reason);
 
@@ -287,6 +338,8 @@ int run(int argc, char **argv) {
     print_value("%d ", options.threads);
   }
   timer.tic();
+  if (verbose)
+    parameters.progress = ProgressLine();
   pcl::PolygonMesh mesh;
   pcl_ms::Result result;
   const bool reconstructed =

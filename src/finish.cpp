@@ -386,10 +386,11 @@ void dropTriangles(std::vector<Triangle> &triangles, const std::vector<bool> &dr
   triangles.resize(write);
 }
 
-/// Keeps one fan (the largest) at every touched vertex with several, until
-/// no touched vertex has more than one.
-void splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_count,
-                  std::vector<bool> &touched) {
+} // namespace
+
+std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_count,
+                         std::vector<bool> &touched) {
+  const std::size_t before = triangles.size();
   for (bool changed = true; changed;) {
     changed = false;
     const auto at = vertexFans(triangles, vertex_count);
@@ -412,9 +413,8 @@ void splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_count,
     if (changed)
       dropTriangles(triangles, drop, touched);
   }
+  return before - triangles.size();
 }
-
-} // namespace
 
 std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
                                             const std::vector<Eigen::Vector3d> &points,
@@ -498,8 +498,8 @@ std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
 
 std::size_t removeTwistedFans(std::vector<Triangle> &triangles,
                               const std::vector<Eigen::Vector3d> &points,
-                              const std::vector<std::uint32_t> &twisted,
-                              std::vector<bool> &touched) {
+                              const std::vector<std::uint32_t> &twisted, std::vector<bool> &touched,
+                              const std::vector<bool> *anchored_vertices) {
   touched.assign(points.size(), false);
   const std::size_t before = triangles.size();
   // At each twisted spot the corner whose fan is most crumpled (typically a
@@ -510,12 +510,16 @@ std::size_t removeTwistedFans(std::vector<Triangle> &triangles,
     VertexIndex worst = triangles[t][0];
     double worst_spread = -1;
     for (VertexIndex v : triangles[t]) {
+      if (anchored_vertices && (*anchored_vertices)[v])
+        continue;
       const double spread = fanSpread(at[v], triangles, points);
       if (spread > worst_spread) {
         worst_spread = spread;
         worst = v;
       }
     }
+    if (worst_spread < 0) // every corner anchored: leave the twist
+      continue;
     for (std::uint32_t u : at[worst])
       drop[u] = true;
   }
@@ -527,14 +531,15 @@ std::size_t removeTwistedFans(std::vector<Triangle> &triangles,
 
 FinishedSurface finishSurface(std::vector<Triangle> triangles,
                               const std::vector<Eigen::Vector3d> &points, int fill_holes_max_edges,
-                              double max_side) {
+                              double max_side, const std::vector<bool> *anchored_vertices) {
   FinishedSurface surface;
   surface.holes_filled = fillHoles(triangles, points, fill_holes_max_edges, max_side);
   std::vector<std::uint32_t> twisted =
       orientComponents(triangles, points, surface.triangle_component, surface.component_orientable);
   for (int round = 0; round < max_untwist_rounds && !twisted.empty(); ++round) {
     std::vector<bool> touched;
-    surface.twist_triangles_removed += removeTwistedFans(triangles, points, twisted, touched);
+    surface.twist_triangles_removed +=
+        removeTwistedFans(triangles, points, twisted, touched, anchored_vertices);
     // The loops that removal opened are ours to close, whatever the user's limit.
     surface.holes_filled +=
         fillHoles(triangles, points, max_untwist_loop_edges, max_side, &touched);

@@ -49,15 +49,20 @@ public:
        const Parameters &parameters, GreedyStatistics &statistics)
       : scaffold_(scaffold), candidates_(scaffold.candidates), points_(points),
         parameters_(parameters), statistics_(statistics), mesh_(scaffold, points.size()),
-        states_(candidates_.size()), multi_fan_vertex_(points.size(), false),
-        may_have_several_fans_(points.size(), false) {
+        states_(candidates_.size()), is_fixed_(candidates_.size(), false),
+        multi_fan_vertex_(points.size(), false), may_have_several_fans_(points.size(), false) {
+    for (CandidateIndex t : scaffold.fixed)
+      is_fixed_[t] = true;
     delay_multiplier_.resize(2 * static_cast<std::size_t>(parameters.max_delays) + 1);
     for (std::size_t k = 0; k < delay_multiplier_.size(); ++k)
       delay_multiplier_[k] = std::pow(parameters.delay_factor, static_cast<double>(k));
   }
 
   void run() {
+    acceptFixedTriangles();
     for (CandidateIndex t = 0; t < candidates_.size(); ++t) {
+      if (is_fixed_[t])
+        continue;
       states_[t].cost = static_cast<float>(freshCost(t));
       push(t, candidates_[t].type == CandidateType::ambiguous ? State::queue2 : State::queue1);
     }
@@ -69,16 +74,34 @@ public:
     enforceManifoldVertices();
   }
 
-  std::vector<Triangle> triangles() const {
+  std::vector<Triangle> triangles(bool with_fixed) const {
     std::vector<Triangle> result;
     result.reserve(mesh_.size());
     for (CandidateIndex t = 0; t < candidates_.size(); ++t)
-      if (mesh_.contains(t))
+      if (mesh_.contains(t) && (with_fixed || !is_fixed_[t]))
         result.push_back(candidates_[t].vertices);
     return result;
   }
 
 private:
+  /// Fixed triangles are in the surface before anything is ranked, so their
+  /// context counts from the start; nothing ever undoes them. A triangle
+  /// that would overfill an edge is left out (callers pass edge-manifold sets).
+  void acceptFixedTriangles() {
+    for (CandidateIndex t : scaffold_.fixed) {
+      if (mesh_.contains(t) || hasFullEdge(t)) {
+        is_fixed_[t] = mesh_.contains(t);
+        continue;
+      }
+      mesh_.add(t);
+      states_[t].state = State::accepted;
+      propagateContext(t, +1.0);
+      // Fixed pieces may meet at a vertex without forming one fan yet.
+      for (VertexIndex v : candidates_[t].vertices)
+        may_have_several_fans_[v] = true;
+    }
+  }
+
   // ---- costs -------------------------------------------------------------
 
   double freshCost(CandidateIndex t) const {
@@ -214,7 +237,7 @@ private:
         continue;
       const auto occupants = mesh_.edgeTriangles(e);
       for (CandidateIndex u : occupants)
-        if (u != no_candidate && states_[u].cost > states_[t].cost) {
+        if (u != no_candidate && !is_fixed_[u] && states_[u].cost > states_[t].cost) {
           undo(u);
           ++statistics.undone;
         }
@@ -330,7 +353,8 @@ private:
     for (const auto &fan : fans)
       if (&fan != closed)
         for (CandidateIndex u : fan)
-          undo(u);
+          if (!is_fixed_[u])
+            undo(u);
     multi_fan_vertex_[v] = false;
   }
 
@@ -427,6 +451,8 @@ private:
       if (mesh_.edgeTriangleCount(e) != 2)
         continue;
       const auto [first, second] = mesh_.edgeTriangles(e);
+      if (is_fixed_[first] || is_fixed_[second])
+        continue;
       VertexIndex a = 0, c = 0;
       for (int k = 0; k < 3; ++k)
         if (candidates_[first].edges[k] == e) {
@@ -469,7 +495,7 @@ private:
   void removeFlapsAndIsolatedTriangles() {
     std::vector<CandidateIndex> loose;
     for (CandidateIndex t = 0; t < candidates_.size(); ++t) {
-      if (!mesh_.contains(t))
+      if (!mesh_.contains(t) || is_fixed_[t])
         continue;
       int shared_edges = 0;
       for (EdgeIndex e : candidates_[t].edges)
@@ -483,11 +509,11 @@ private:
   }
 
   /// Final guarantee: every vertex's triangles form one fan. At a bow-tie the
-  /// fan with the most triangles stays (ties: the cheaper one) and the others
-  /// are undone; removals can split fans at neighbouring vertices, so those
-  /// are checked again. A vertex gets a second fan only when a triangle at it
-  /// was removed or accepted against the vertex-face incidence rule: only
-  /// those vertices are looked at.
+  /// fan with the most fixed triangles, then the most triangles (ties: the
+  /// cheaper one) stays and the others are undone, except fixed triangles; removals can split fans
+  /// at neighbouring vertices, so those are checked again. A vertex gets a second fan only when a
+  /// triangle at it was removed or accepted against the vertex-face incidence rule: only those
+  /// vertices are looked at.
   void enforceManifoldVertices() {
     std::vector<VertexIndex> pending;
     std::vector<bool> is_pending(points_.size(), false);
@@ -504,14 +530,22 @@ private:
       if (fans.size() <= 1)
         continue;
       std::size_t best = 0;
-      for (std::size_t f = 1; f < fans.size(); ++f)
-        if (fans[f].size() > fans[best].size() ||
-            (fans[f].size() == fans[best].size() && fanCost(fans[f]) < fanCost(fans[best])))
+      for (std::size_t f = 1; f < fans.size(); ++f) {
+        const std::size_t fixed = fixedCount(fans[f]), best_fixed = fixedCount(fans[best]);
+        if (fixed != best_fixed) {
+          if (fixed > best_fixed)
+            best = f;
+        } else if (fans[f].size() > fans[best].size() || (fans[f].size() == fans[best].size() &&
+                                                          fanCost(fans[f]) < fanCost(fans[best]))) {
           best = f;
+        }
+      }
       for (std::size_t f = 0; f < fans.size(); ++f) {
         if (f == best)
           continue;
         for (CandidateIndex u : fans[f]) {
+          if (is_fixed_[u])
+            continue;
           removeFromMesh(u);
           states_[u].state = State::dropped;
           ++statistics_.cleanup_undone;
@@ -523,6 +557,11 @@ private:
         }
       }
     }
+  }
+
+  std::size_t fixedCount(const std::vector<CandidateIndex> &fan) const {
+    return static_cast<std::size_t>(
+        std::count_if(fan.begin(), fan.end(), [&](CandidateIndex u) { return is_fixed_[u]; }));
   }
 
   double fanCost(const std::vector<CandidateIndex> &fan) const {
@@ -549,6 +588,7 @@ private:
     std::uint8_t incidence_delays = 0, ranking_delays = 0, undos = 0;
   };
   std::vector<CandidateState> states_;
+  std::vector<bool> is_fixed_;
   std::vector<bool> multi_fan_vertex_;
   std::vector<bool> may_have_several_fans_;
   std::vector<double> delay_multiplier_;
@@ -564,6 +604,8 @@ GreedyMesher::~GreedyMesher() = default;
 
 void GreedyMesher::run() { impl_->run(); }
 
-std::vector<Triangle> GreedyMesher::triangles() const { return impl_->triangles(); }
+std::vector<Triangle> GreedyMesher::triangles(bool with_fixed) const {
+  return impl_->triangles(with_fixed);
+}
 
 } // namespace pcl_ms

@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+#include <pcl_ms/buckets.h>
 #include <pcl_ms/finish.h>
 #include <pcl_ms/greedy.h>
 #include <pcl_ms/reconstruct.h>
@@ -32,6 +33,12 @@ std::string Parameters::validate() const {
     reason << "max delays must be in [0, 100] (got " << max_delays << ")";
   else if (num_threads < 0)
     reason << "number of threads must be >= 0 (got " << num_threads << ")";
+  else if (bucket_points != 0 && bucket_points < min_bucket_points)
+    reason << "bucket size must be 0 (automatic) or at least " << min_bucket_points
+           << " points (got " << bucket_points << ")";
+  else if (grid_buckets < 0 || grid_buckets > max_grid_buckets)
+    reason << "grid buckets must be in [0, " << max_grid_buckets << "] (got " << grid_buckets
+           << ")";
   return reason.str();
 }
 
@@ -65,7 +72,12 @@ struct PreparedPoints {
   std::vector<Eigen::Vector3d> positions;
   std::vector<Eigen::Vector3f> normals;
   std::vector<VertexIndex> user_index;
+  /// For each user record, its distinct point (duplicates share one), or
+  /// not_prepared for records left out (NaN/Inf, not in the indices).
+  std::vector<VertexIndex> prepared_of_record;
 };
+
+constexpr VertexIndex not_prepared = std::numeric_limits<VertexIndex>::max();
 
 const float *recordAt(const float *base, std::size_t stride, std::size_t record) {
   return reinterpret_cast<const float *>(reinterpret_cast<const char *>(base) + record * stride);
@@ -109,11 +121,18 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, Result &r
     return pa < pb || (pa == pb && a < b);
   });
   std::vector<bool> keep(records.size(), true);
-  for (std::size_t i = 1; i < order.size(); ++i)
-    if (coordinates(records[order[i]]) == coordinates(records[order[i - 1]]))
+  std::vector<std::size_t> representative(records.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    representative[order[i]] = order[i];
+    if (i > 0 && coordinates(records[order[i]]) == coordinates(records[order[i - 1]])) {
       keep[order[i]] = false;
+      representative[order[i]] = representative[order[i - 1]];
+    }
+  }
 
   PreparedPoints prepared;
+  prepared.prepared_of_record.assign(view.size, not_prepared);
+  std::vector<VertexIndex> prepared_of_kept(records.size(), not_prepared);
   Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d high = -low;
   for (std::size_t i = 0; i < records.size(); ++i) {
@@ -125,6 +144,7 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, Result &r
     const Eigen::Vector3d position(p[0], p[1], p[2]);
     low = low.cwiseMin(position);
     high = high.cwiseMax(position);
+    prepared_of_kept[i] = static_cast<VertexIndex>(prepared.positions.size());
     prepared.positions.push_back(position);
     prepared.user_index.push_back(records[i]);
     if (with_normals) {
@@ -137,6 +157,8 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, Result &r
                                      : Eigen::Vector3f::Zero());
     }
   }
+  for (std::size_t i = 0; i < records.size(); ++i)
+    prepared.prepared_of_record[records[i]] = prepared_of_kept[representative[i]];
   result.used_points = prepared.positions.size();
   if (prepared.positions.size() < 3) {
     std::ostringstream reason;
@@ -151,9 +173,57 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, Result &r
   return prepared;
 }
 
+/// The user's initial triangles in distinct-point indices. Each must use
+/// three distinct input points, appear once, and share each edge with at
+/// most one other: the greedy builds a 2-manifold around them.
+std::vector<Triangle> prepareInitialTriangles(const std::vector<Triangle> &initial,
+                                              const PreparedPoints &prepared) {
+  std::vector<Triangle> mapped;
+  mapped.reserve(initial.size());
+  for (std::size_t t = 0; t < initial.size(); ++t) {
+    Triangle triangle;
+    for (int k = 0; k < 3; ++k) {
+      const VertexIndex record = initial[t][k];
+      const VertexIndex v = record < prepared.prepared_of_record.size()
+                                ? prepared.prepared_of_record[record]
+                                : not_prepared;
+      if (v == not_prepared)
+        throw ReconstructionError("initial triangle " + std::to_string(t) + " uses point " +
+                                  std::to_string(record) +
+                                  ", which is not a valid point of the input");
+      triangle[k] = v;
+    }
+    std::sort(triangle.begin(), triangle.end());
+    if (triangle[0] == triangle[1] || triangle[1] == triangle[2])
+      throw ReconstructionError("initial triangle " + std::to_string(t) +
+                                " has two corners at the same position");
+    mapped.push_back(triangle);
+  }
+  std::vector<Triangle> sorted = mapped;
+  std::sort(sorted.begin(), sorted.end());
+  if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
+    throw ReconstructionError("the initial triangles contain the same triangle twice");
+  std::vector<std::pair<VertexIndex, VertexIndex>> edges;
+  for (const Triangle &triangle : sorted) {
+    edges.emplace_back(triangle[0], triangle[1]);
+    edges.emplace_back(triangle[1], triangle[2]);
+    edges.emplace_back(triangle[0], triangle[2]);
+  }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t i = 2; i < edges.size(); ++i)
+    if (edges[i] == edges[i - 2])
+      throw ReconstructionError("the initial triangles share an edge among more than two");
+  return mapped;
+}
+
 } // namespace
 
 Result reconstruct(const PointView &points, const Parameters &parameters) {
+  return reconstruct(points, parameters, {});
+}
+
+Result reconstruct(const PointView &points, const Parameters &parameters,
+                   const std::vector<Triangle> &initial_triangles) {
   const Clock::time_point start = Clock::now();
   const std::string invalid = parameters.validate();
   if (!invalid.empty())
@@ -167,27 +237,43 @@ Result reconstruct(const PointView &points, const Parameters &parameters) {
   result.timings.prepare = secondsSince(stage);
   result.peak_memory.prepare = peakResidentBytes();
 
-  stage = Clock::now();
-  ScaffoldOptions options;
-  options.rho = parameters.rho;
-  options.num_threads = parameters.num_threads;
-  options.normals = parameters.use_normals ? &prepared.normals : nullptr;
-  options.normal_weight = parameters.normal_weight;
-  const MedialScaffold scaffold = buildMedialScaffold(prepared.positions, options);
-  result.timings.delaunay = scaffold.delaunay_seconds;
-  result.timings.scaffold = secondsSince(stage) - scaffold.delaunay_seconds;
-  result.planar = scaffold.planar;
-  result.d_med = scaffold.d_med;
-  result.d_max = scaffold.d_max;
-  result.candidates_type1 = scaffold.type1;
-  result.candidates_type2 = scaffold.type2;
-  result.candidates_type3 = scaffold.type3;
-  result.candidates_oversize = scaffold.oversize;
-  result.peak_memory.scaffold = peakResidentBytes();
+  const std::vector<Triangle> fixed = prepareInitialTriangles(initial_triangles, prepared);
+  const std::vector<Eigen::Vector3f> *normals =
+      parameters.use_normals ? &prepared.normals : nullptr;
 
-  stage = Clock::now();
   std::vector<Triangle> triangles;
-  {
+  // Initial triangles are honoured by the one-piece path only.
+  if (fixed.empty() && usesBuckets(prepared.positions.size(), parameters)) {
+    BucketedSurface bucketed = meshInBuckets(prepared.positions, normals, parameters);
+    triangles = std::move(bucketed.triangles);
+    result.d_med = bucketed.d_med;
+    result.d_max = parameters.rho * bucketed.d_med;
+    result.bucket_statistics = bucketed.statistics;
+    result.timings.delaunay = bucketed.delaunay_seconds;
+    result.timings.scaffold = bucketed.scaffold_seconds;
+    result.timings.greedy = bucketed.greedy_seconds;
+    result.peak_memory.scaffold = result.peak_memory.greedy = peakResidentBytes();
+  } else {
+    stage = Clock::now();
+    ScaffoldOptions options;
+    options.rho = parameters.rho;
+    options.num_threads = parameters.num_threads;
+    options.normals = normals;
+    options.normal_weight = parameters.normal_weight;
+    options.fixed_triangles = fixed.empty() ? nullptr : &fixed;
+    const MedialScaffold scaffold = buildMedialScaffold(prepared.positions, options);
+    result.timings.delaunay = scaffold.delaunay_seconds;
+    result.timings.scaffold = secondsSince(stage) - scaffold.delaunay_seconds;
+    result.planar = scaffold.planar;
+    result.d_med = scaffold.d_med;
+    result.d_max = scaffold.d_max;
+    result.candidates_type1 = scaffold.type1;
+    result.candidates_type2 = scaffold.type2;
+    result.candidates_type3 = scaffold.type3;
+    result.candidates_oversize = scaffold.oversize;
+    result.peak_memory.scaffold = peakResidentBytes();
+
+    stage = Clock::now();
     GreedyMesher mesher(scaffold, prepared.positions, parameters);
     mesher.run();
     triangles = mesher.triangles();
@@ -195,13 +281,22 @@ Result reconstruct(const PointView &points, const Parameters &parameters) {
     result.pass2 = mesher.statistics().pass2;
     result.cleanup_undone = mesher.statistics().cleanup_undone;
     result.swapped_pairs = mesher.statistics().swapped_pairs;
+    result.timings.greedy = secondsSince(stage);
+    result.peak_memory.greedy = peakResidentBytes();
   }
-  result.timings.greedy = secondsSince(stage);
-  result.peak_memory.greedy = peakResidentBytes();
 
   stage = Clock::now();
-  FinishedSurface surface = finishSurface(std::move(triangles), prepared.positions,
-                                          parameters.fill_holes_max_edges, scaffold.d_max);
+  // The user's initial triangles must survive the twist repair.
+  std::vector<bool> anchored;
+  if (!fixed.empty()) {
+    anchored.assign(prepared.positions.size(), false);
+    for (const Triangle &triangle : fixed)
+      for (VertexIndex v : triangle)
+        anchored[v] = true;
+  }
+  FinishedSurface surface =
+      finishSurface(std::move(triangles), prepared.positions, parameters.fill_holes_max_edges,
+                    result.d_max, anchored.empty() ? nullptr : &anchored);
   // Back to the user's records.
   for (Triangle &triangle : surface.triangles)
     for (VertexIndex &v : triangle)

@@ -144,13 +144,15 @@ public:
     scaffold_.planar = delaunay.dimension() == 2;
 
     collectCells(delaunay);
-    scaffold_.d_med = medianCircumradius(delaunay);
+    scaffold_.d_med = options_.d_med > 0 ? options_.d_med : medianCircumradius(delaunay);
     scaffold_.d_max = options_.rho * scaffold_.d_med;
     buildCandidates(delaunay);
     // The tetrahedra are no longer needed: free them before the edge graph.
     cells_.clear();
     cells_.shrink_to_fit();
     delaunay.clear();
+    if (options_.fixed_triangles)
+      addFixedTriangles(*options_.fixed_triangles);
     buildEdgeGraph();
     return std::move(scaffold_);
   }
@@ -284,6 +286,8 @@ private:
                   Candidate candidate;
                   for (int k = 0; k < 3; ++k)
                     candidate.vertices[k] = handles[k]->info();
+                  if (touchesFrozenVertex(candidate.vertices))
+                    return;
                   std::sort(candidate.vertices.begin(), candidate.vertices.end());
                   const Eigen::Vector3d &a = points_[candidate.vertices[0]],
                                         &b = points_[candidate.vertices[1]],
@@ -343,6 +347,54 @@ private:
       chunk = ChunkCandidates();
     }
   }
+
+  bool touchesFrozenVertex(const std::array<VertexIndex, 3> &vertices) const {
+    if (!options_.frozen_vertices)
+      return false;
+    for (VertexIndex v : vertices)
+      if ((*options_.frozen_vertices)[v])
+        return true;
+    return false;
+  }
+
+  /// Finds each fixed triangle among the candidates, appending those that
+  /// are missing (not Delaunay here, too long, or on a frozen vertex).
+  void addFixedTriangles(const std::vector<Triangle> &fixed) {
+    std::vector<std::pair<Triangle, std::size_t>> sorted(fixed.size());
+    for (std::size_t i = 0; i < fixed.size(); ++i) {
+      sorted[i] = {fixed[i], i};
+      std::sort(sorted[i].first.begin(), sorted[i].first.end());
+    }
+    std::sort(sorted.begin(), sorted.end());
+    scaffold_.fixed.assign(fixed.size(), no_fixed_candidate);
+    for (CandidateIndex t = 0; t < scaffold_.candidates.size(); ++t) {
+      const Triangle &vertices = scaffold_.candidates[t].vertices;
+      auto it =
+          std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(vertices, std::size_t{0}));
+      for (; it != sorted.end() && it->first == vertices; ++it)
+        scaffold_.fixed[it->second] = t;
+    }
+    for (std::size_t i = 0; i < sorted.size(); ++i) {
+      const auto &[vertices, position] = sorted[i];
+      if (scaffold_.fixed[position] != no_fixed_candidate)
+        continue;
+      if (i > 0 && sorted[i - 1].first == vertices) { // listed twice: one candidate
+        scaffold_.fixed[position] = scaffold_.fixed[sorted[i - 1].second];
+        continue;
+      }
+      Candidate candidate;
+      candidate.vertices = vertices;
+      candidate.edges = {0, 0, 0};
+      // Never ranked: it is in the surface from the start.
+      candidate.base_cost = 0;
+      candidate.inverse_shock_compactness = 0;
+      candidate.type = CandidateType::acute;
+      scaffold_.fixed[position] = static_cast<CandidateIndex>(scaffold_.candidates.size());
+      scaffold_.candidates.push_back(candidate);
+    }
+  }
+
+  static constexpr CandidateIndex no_fixed_candidate = std::numeric_limits<CandidateIndex>::max();
 
   /// Numbers the candidates' edges and lists the candidates on each edge.
   void buildEdgeGraph() {

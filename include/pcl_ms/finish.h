@@ -49,15 +49,23 @@ std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
 /// crumpled fan around a stray point), removes the most crumpled corner's
 /// fan and splits any bow-tie this leaves, so that hole filling can close the
 /// spot again. Returns how many triangles it removed; their corners are
-/// marked in touched.
+/// marked in touched. The fans of anchored vertices (corners of the user's
+/// initial triangles) are never removed.
 std::size_t removeTwistedFans(std::vector<Triangle> &triangles,
                               const std::vector<Eigen::Vector3d> &points,
-                              const std::vector<std::uint32_t> &twisted,
-                              std::vector<bool> &touched);
+                              const std::vector<std::uint32_t> &twisted, std::vector<bool> &touched,
+                              const std::vector<bool> *anchored_vertices = nullptr);
+
+/// Keeps one fan (the largest) at every touched vertex whose triangles form
+/// several, until none has more than one; the corners of removed triangles
+/// become touched. Returns how many triangles it removed.
+std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_count,
+                         std::vector<bool> &touched);
 
 /// All of the above in order.
 FinishedSurface finishSurface(std::vector<Triangle> triangles,
                               const std::vector<Eigen::Vector3d> &points, int fill_holes_max_edges,
-                              double max_side);
+                              double max_side,
+                              const std::vector<bool> *anchored_vertices = nullptr);
 
 } // namespace pcl_ms

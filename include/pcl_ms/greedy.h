@@ -33,11 +33,13 @@ public:
   GreedyMesher &operator=(const GreedyMesher &) = delete;
 
   /// Pass 1 (types I, II), clean-up, pass 2 (type III and demoted), then
-  /// the final sweep that guarantees a 2-manifold result.
+  /// the final sweep that guarantees a 2-manifold result. The scaffold's
+  /// fixed triangles are in the mesh from the start and never undone.
   void run();
 
-  /// Accepted triangles as distinct-point indices, in candidate order.
-  std::vector<Triangle> triangles() const;
+  /// Accepted triangles as distinct-point indices, in candidate order;
+  /// without the scaffold's fixed triangles when `with_fixed` is false.
+  std::vector<Triangle> triangles(bool with_fixed = true) const;
   const GreedyStatistics &statistics() const { return statistics_; }
 
 private:

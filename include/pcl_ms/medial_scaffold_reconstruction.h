@@ -95,6 +95,26 @@ public:
   void setNumberOfThreads(int threads) { parameters_.num_threads = threads; }
   int getNumberOfThreads() const { return parameters_.num_threads; }
 
+  /** \brief Mesh clouds larger than this in buckets of about this many
+   * points, stitched together (default 0 = automatic: buckets of
+   * pcl_ms::default_bucket_points above pcl_ms::automatic_bucketing_threshold
+   * points). A value at least the cloud's size meshes it in one piece. */
+  void setBucketSize(std::size_t points) { parameters_.bucket_points = points; }
+  std::size_t getBucketSize() const { return parameters_.bucket_points; }
+
+  /** \brief Cut the bounding box into n x n x n buckets instead (default 0:
+   * off). */
+  void setGridBuckets(int n) { parameters_.grid_buckets = n; }
+  int getGridBuckets() const { return parameters_.grid_buckets; }
+
+  /** \brief Triangles (indices into the input cloud) that are part of the
+   * surface from the start; the method completes the mesh around them
+   * (default: none). They must be edge-manifold and use valid points. */
+  void setInitialTriangles(const std::vector<pcl::Vertices> &triangles) {
+    initial_triangles_ = triangles;
+  }
+  const std::vector<pcl::Vertices> &getInitialTriangles() const { return initial_triangles_; }
+
   /** \brief All parameters at once (core struct). */
   void setParameters(const pcl_ms::Parameters &parameters) { parameters_ = parameters; }
   const pcl_ms::Parameters &getParameters() const { return parameters_; }
@@ -120,6 +140,7 @@ private:
 
   pcl_ms::Parameters parameters_;
   NormalCloud::ConstPtr normals_;
+  std::vector<pcl::Vertices> initial_triangles_;
   pcl_ms::Result result_;
   std::string error_message_;
 

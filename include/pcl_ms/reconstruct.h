@@ -6,6 +6,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace pcl_ms {
 
@@ -21,5 +22,14 @@ public:
 /// Throws ReconstructionError on unusable input (no or too few distinct
 /// points, collinear points, invalid parameters).
 Result reconstruct(const PointView &points, const Parameters &parameters);
+
+/// Re-meshes around a partial mesh: `initial_triangles` (user record
+/// indices, edge-manifold, each once) are in the surface from the start and
+/// the method completes it around them. Throws ReconstructionError when an
+/// initial triangle uses an invalid or missing point, repeats, is
+/// degenerate, or a third triangle is put on an edge. The one-piece path is
+/// used whatever the cloud's size.
+Result reconstruct(const PointView &points, const Parameters &parameters,
+                   const std::vector<Triangle> &initial_triangles);
 
 } // namespace pcl_ms

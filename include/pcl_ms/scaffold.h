@@ -42,6 +42,8 @@ struct MedialScaffold {
   std::vector<Candidate> candidates;
   std::vector<std::uint32_t> edge_offsets; // edges + 1 entries
   std::vector<CandidateIndex> edge_candidates;
+  /// The candidates of ScaffoldOptions::fixed_triangles, in the same order.
+  std::vector<CandidateIndex> fixed;
 
   double d_med = 0; // median circumradius of type I and II triangles
   double d_max = 0; // rho * d_med
@@ -67,6 +69,15 @@ struct ScaffoldOptions {
   /// Optional unit normals per point (same indexing as points) and kappa.
   const std::vector<Eigen::Vector3f> *normals = nullptr;
   double normal_weight = 1.0;
+  /// d_med to use instead of measuring it (> 0): the buckets and seams of
+  /// one cloud share one value, so they agree on d_max.
+  double d_med = 0;
+  /// Triangles already in the surface (partial re-meshing, stitching). Each
+  /// becomes a candidate even when it is not a Delaunay triangle of these
+  /// points or is longer than d_max; the greedy keeps them all.
+  const std::vector<Triangle> *fixed_triangles = nullptr;
+  /// Vertices that only fixed triangles may use (one flag per point).
+  const std::vector<bool> *frozen_vertices = nullptr;
 };
 
 /// Builds the scaffold of distinct points (at least 3, not all collinear:

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,16 @@ struct Parameters {
   bool error_recovery = true;
   /// Worker threads for the parallel stages; 0 = all cores. Never changes the result.
   int num_threads = 1;
+  /// Large clouds are meshed in buckets of about this many points that are
+  /// stitched together (paper §4). 0 = automatic: buckets of
+  /// default_bucket_points above automatic_bucketing_threshold points, one
+  /// piece below (buckets.h). A cloud no larger than this is one piece.
+  std::size_t bucket_points = 0;
+  /// > 0: cut the bounding box into grid_buckets^3 equal buckets instead.
+  int grid_buckets = 0;
+  /// Called with (units done, units in all) as buckets and seams finish,
+  /// from worker threads one call at a time.
+  std::function<void(std::size_t, std::size_t)> progress;
 
   /// Empty when valid, else a one-line reason.
   std::string validate() const;
@@ -68,7 +79,21 @@ struct PassStatistics {
   std::size_t demoted = 0;
 };
 
-/// Wall-clock seconds per stage.
+/// What the bucketed path did (all zero when the cloud was one piece).
+struct BucketStatistics {
+  std::size_t buckets = 0;
+  std::size_t margin_points = 0; // points meshed again as some bucket's margin
+  std::size_t seam_zones = 0;
+  std::size_t seam_points = 0;               // points in all seam zones together
+  std::size_t seam_triangles = 0;            // triangles the seams added
+  std::size_t failed_units = 0;              // buckets or zones left empty (e.g. collinear points)
+  std::size_t bow_tie_triangles_removed = 0; // smaller fans where seams met
+  double buckets_seconds = 0;                // wall clock
+  double seams_seconds = 0;                  // wall clock
+};
+
+/// Wall-clock seconds per stage. In bucketed runs delaunay, scaffold and
+/// greedy are summed over buckets and seams (thread time, not wall clock).
 struct StageTimings {
   double prepare = 0;  // validation, NaN and duplicate removal
   double delaunay = 0; // Delaunay tetrahedralisation
@@ -112,6 +137,7 @@ struct Result {
   std::size_t cleanup_undone = 0; // flaps/isolated triangles and final sweep
   std::size_t swapped_pairs = 0;  // non-Delaunay quads re-triangulated
   std::size_t holes_filled = 0;
+  BucketStatistics bucket_statistics;
   StageTimings timings;
   StagePeakMemory peak_memory;
 

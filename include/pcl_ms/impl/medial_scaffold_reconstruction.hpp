@@ -9,6 +9,7 @@
 #include <pcl/conversions.h>
 #include <pcl/point_types.h> // pcl::traits::has_normal_v
 
+#include <algorithm>
 #include <cstddef>
 
 namespace pcl {
@@ -85,8 +86,26 @@ bool MedialScaffoldReconstruction<PointInT>::runCore(std::vector<pcl::Vertices> 
     }
   }
 
+  std::vector<pcl_ms::Triangle> initial;
+  initial.reserve(initial_triangles_.size());
+  for (std::size_t t = 0; t < initial_triangles_.size(); ++t) {
+    const auto &vertices = initial_triangles_[t].vertices;
+    const bool negative =
+        std::any_of(vertices.begin(), vertices.end(), [](pcl::index_t v) { return v < 0; });
+    if (vertices.size() != 3 || negative) {
+      error_message_ = "initial polygon " + std::to_string(t) +
+                       (negative ? " has a negative index"
+                                 : " has " + std::to_string(vertices.size()) + " vertices, not 3");
+      PCL_ERROR("[pcl::%s::reconstruct] %s\n", getClassName().c_str(), error_message_.c_str());
+      return false;
+    }
+    initial.push_back({static_cast<pcl_ms::VertexIndex>(vertices[0]),
+                       static_cast<pcl_ms::VertexIndex>(vertices[1]),
+                       static_cast<pcl_ms::VertexIndex>(vertices[2])});
+  }
+
   try {
-    result_ = pcl_ms::reconstruct(view, parameters_);
+    result_ = pcl_ms::reconstruct(view, parameters_, initial);
   } catch (const pcl_ms::ReconstructionError &error) {
     error_message_ = error.what();
     PCL_ERROR("[pcl::%s::reconstruct] %s\n", getClassName().c_str(), error_message_.c_str());

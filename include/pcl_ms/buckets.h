@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Stage for large clouds (paper §4): the cloud is cut into buckets, each
+// meshed with a margin of its neighbours' points; the triangles inside a
+// bucket are kept, and the zones along the cuts are meshed again with the
+// kept triangles around them fixed. Buckets and zones are independent units
+// of work (points in, triangles out), run in parallel.
+#pragma once
+
+#include <pcl_ms/types.h>
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace pcl_ms {
+
+/// Target bucket size when Parameters::bucket_points is 0 (automatic).
+constexpr std::size_t default_bucket_points = 200000;
+/// Clouds above this many distinct points are meshed in buckets by default.
+constexpr std::size_t automatic_bucketing_threshold = 600000;
+
+/// Smaller buckets would be mostly margin.
+constexpr std::size_t min_bucket_points = 1000;
+/// grid_buckets^3 buckets at most.
+constexpr int max_grid_buckets = 64;
+
+/// One self-contained unit of work: a bucket with its margin, or a seam
+/// zone. Indices are local to `points`.
+struct BucketTask {
+  std::vector<Eigen::Vector3d> points;
+  /// Empty, or one unit normal per point (used when Parameters::use_normals).
+  std::vector<Eigen::Vector3f> normals;
+  /// Triangles are kept only when all three vertices are core points; the
+  /// others are margin, there to give the core the right neighbourhood.
+  std::vector<bool> core;
+  /// Triangles already in the surface; they stay and are not returned.
+  std::vector<Triangle> fixed_triangles;
+  /// Points that only fixed triangles may use (empty: none).
+  std::vector<bool> frozen;
+  /// d_med to use (> 0), or 0 to measure it on these points.
+  double d_med = 0;
+};
+
+struct BucketOutcome {
+  std::vector<Triangle> triangles; // new triangles on core points, local indices
+  double d_med = 0;
+  double delaunay_seconds = 0, scaffold_seconds = 0, greedy_seconds = 0;
+  /// Not empty when the unit could not be meshed (e.g. collinear points).
+  std::string error;
+};
+
+/// Scaffold and greedy passes on one unit (no hole filling or orientation:
+/// those run once on the whole surface). Single-threaded.
+BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters);
+
+/// Whether reconstruct() meshes `points` distinct points in buckets.
+bool usesBuckets(std::size_t points, const Parameters &parameters);
+
+struct BucketedSurface {
+  std::vector<Triangle> triangles; // indices into the points given
+  double d_med = 0;                // median of the buckets' d_med
+  BucketStatistics statistics;
+  // Summed over buckets and seams (thread time).
+  double delaunay_seconds = 0, scaffold_seconds = 0, greedy_seconds = 0;
+};
+
+/// Meshes the points in buckets and stitches them. `normals` is null or has
+/// one entry per point. The result does not depend on the thread count.
+BucketedSurface meshInBuckets(const std::vector<Eigen::Vector3d> &points,
+                              const std::vector<Eigen::Vector3f> *normals,
+                              const Parameters &parameters);
+
+} // namespace pcl_ms

@@ -1,0 +1,565 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <pcl_ms/buckets.h>
+#include <pcl_ms/finish.h>
+#include <pcl_ms/greedy.h>
+#include <pcl_ms/reconstruct.h>
+#include <pcl_ms/scaffold.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <numeric>
+
+namespace pcl_ms {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// The margin reaches this many d_med beyond the seam width, so that the
+// triangles a seam keeps fixed were decided with their neighbourhood.
+constexpr double margin_context_in_d_med = 6;
+
+// Nearest-neighbour samples per bucket for the spacing estimate.
+constexpr std::size_t spacing_samples_per_bucket = 32;
+
+// d_med (median circumradius of Gabriel triangles) over the median
+// nearest-neighbour distance; measured on the bunny and its samplings.
+constexpr double d_med_per_spacing = 0.75;
+
+struct Box {
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
+  Eigen::Vector3d high = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+
+  bool contains(const Eigen::Vector3d &p) const {
+    return (p.array() >= low.array()).all() && (p.array() <= high.array()).all();
+  }
+  bool intersects(const Box &other) const {
+    return (low.array() <= other.high.array()).all() && (other.low.array() <= high.array()).all();
+  }
+  Box expanded(double width) const {
+    Box box = *this;
+    box.low.array() -= width;
+    box.high.array() += width;
+    return box;
+  }
+};
+
+/// A node of the bucket tree. Leaves are buckets; an inner node's split
+/// plane is the seam between its two subtrees. Leaves are numbered in
+/// depth-first order, so a subtree's leaves form a range.
+struct Node {
+  Box region;
+  int axis = -1; // -1 for a leaf
+  double split = 0;
+  int children[2] = {-1, -1};
+  int depth = 0;
+  std::uint32_t first_leaf = 0, end_leaf = 0;
+  std::vector<VertexIndex> points; // leaves: their points, ascending
+  std::vector<Triangle> triangles; // kept so far in this subtree
+};
+
+class BucketTree {
+public:
+  BucketTree(const std::vector<Eigen::Vector3d> &points, std::size_t bucket_points, int grid)
+      : points_(points), leaf_of_(points.size(), 0) {
+    std::vector<VertexIndex> order(points.size());
+    std::iota(order.begin(), order.end(), 0);
+    if (grid > 0) {
+      Eigen::Vector3d low = points[0], high = points[0];
+      for (const Eigen::Vector3d &p : points) {
+        low = low.cwiseMin(p);
+        high = high.cwiseMax(p);
+      }
+      grid_low_ = low;
+      grid_cell_ = ((high - low) / grid).cwiseMax(Eigen::Vector3d::Constant(1e-300));
+      grid_ = grid;
+      root_ = buildGrid(order, 0, order.size(), Box(), {0, 0, 0}, {grid, grid, grid}, 0);
+    } else {
+      root_ = buildMedian(order, 0, order.size(), Box(), bucket_points, 0);
+    }
+    numberLeaves(root_);
+  }
+
+  int root() const { return root_; }
+  std::vector<Node> &nodes() { return nodes_; }
+  const std::vector<int> &leaves() const { return leaves_; }
+  std::uint32_t leafOf(VertexIndex v) const { return leaf_of_[v]; }
+  bool inSubtree(VertexIndex v, const Node &node) const {
+    return leaf_of_[v] >= node.first_leaf && leaf_of_[v] < node.end_leaf;
+  }
+
+  /// Points inside `box` that also pass `accept`, ascending.
+  template <typename Accept>
+  std::vector<VertexIndex> gather(const Box &box, const Accept &accept) const {
+    std::vector<VertexIndex> found;
+    std::vector<int> stack{root_};
+    while (!stack.empty()) {
+      const Node &node = nodes_[stack.back()];
+      stack.pop_back();
+      if (!node.region.intersects(box))
+        continue;
+      if (node.axis < 0) {
+        for (VertexIndex v : node.points)
+          if (box.contains(points_[v]) && accept(v))
+            found.push_back(v);
+      } else {
+        for (int child : node.children)
+          if (child >= 0)
+            stack.push_back(child);
+      }
+    }
+    std::sort(found.begin(), found.end());
+    return found;
+  }
+
+private:
+  int makeLeaf(std::vector<VertexIndex> &order, std::size_t begin, std::size_t end,
+               const Box &region, int depth) {
+    Node node;
+    node.region = region;
+    node.depth = depth;
+    node.points.assign(order.begin() + begin, order.begin() + end);
+    std::sort(node.points.begin(), node.points.end());
+    nodes_.push_back(std::move(node));
+    return static_cast<int>(nodes_.size() - 1);
+  }
+
+  int makeInner(const Box &region, int axis, double split, int depth, int left, int right) {
+    if (left < 0 || right < 0) // one side empty: no seam here
+      return left < 0 ? right : left;
+    Node node;
+    node.region = region;
+    node.axis = axis;
+    node.split = split;
+    node.depth = depth;
+    node.children[0] = left;
+    node.children[1] = right;
+    nodes_.push_back(std::move(node));
+    return static_cast<int>(nodes_.size() - 1);
+  }
+
+  /// Splits at the median of the longest side until buckets are small enough.
+  int buildMedian(std::vector<VertexIndex> &order, std::size_t begin, std::size_t end,
+                  const Box &region, std::size_t bucket_points, int depth) {
+    if (begin == end)
+      return -1;
+    if (end - begin <= bucket_points)
+      return makeLeaf(order, begin, end, region, depth);
+    Eigen::Vector3d low = points_[order[begin]], high = low;
+    for (std::size_t i = begin; i < end; ++i) {
+      low = low.cwiseMin(points_[order[i]]);
+      high = high.cwiseMax(points_[order[i]]);
+    }
+    int axis = 0;
+    (high - low).maxCoeff(&axis);
+    const std::size_t middle = begin + (end - begin) / 2;
+    // Ties broken by index: the split does not depend on the input order.
+    std::nth_element(order.begin() + begin, order.begin() + middle, order.begin() + end,
+                     [&](VertexIndex a, VertexIndex b) {
+                       const double pa = points_[a][axis], pb = points_[b][axis];
+                       return pa < pb || (pa == pb && a < b);
+                     });
+    const double split = points_[order[middle]][axis];
+    Box left_region = region, right_region = region;
+    left_region.high[axis] = split;
+    right_region.low[axis] = split;
+    const int left = buildMedian(order, begin, middle, left_region, bucket_points, depth + 1);
+    const int right = buildMedian(order, middle, end, right_region, bucket_points, depth + 1);
+    return makeInner(region, axis, split, depth, left, right);
+  }
+
+  int gridCell(const Eigen::Vector3d &p, int axis) const {
+    const int cell = static_cast<int>(std::floor((p[axis] - grid_low_[axis]) / grid_cell_[axis]));
+    return std::clamp(cell, 0, grid_ - 1);
+  }
+
+  /// Splits the grid's cell range in halves, so the grid becomes a tree too.
+  int buildGrid(std::vector<VertexIndex> &order, std::size_t begin, std::size_t end,
+                const Box &region, std::array<int, 3> first, std::array<int, 3> last, int depth) {
+    if (begin == end)
+      return -1;
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+      if (last[a] - first[a] > last[axis] - first[axis])
+        axis = a;
+    if (last[axis] - first[axis] <= 1)
+      return makeLeaf(order, begin, end, region, depth);
+    const int middle_cell = (first[axis] + last[axis]) / 2;
+    const auto middle =
+        std::stable_partition(order.begin() + begin, order.begin() + end, [&](VertexIndex v) {
+          return gridCell(points_[v], axis) < middle_cell;
+        });
+    const std::size_t middle_index = static_cast<std::size_t>(middle - order.begin());
+    const double split = grid_low_[axis] + middle_cell * grid_cell_[axis];
+    Box left_region = region, right_region = region;
+    left_region.high[axis] = split;
+    right_region.low[axis] = split;
+    std::array<int, 3> left_last = last, right_first = first;
+    left_last[axis] = middle_cell;
+    right_first[axis] = middle_cell;
+    const int left =
+        buildGrid(order, begin, middle_index, left_region, first, left_last, depth + 1);
+    const int right =
+        buildGrid(order, middle_index, end, right_region, right_first, last, depth + 1);
+    return makeInner(region, axis, split, depth, left, right);
+  }
+
+  void numberLeaves(int index) {
+    std::vector<std::pair<int, bool>> stack{{index, false}};
+    while (!stack.empty()) {
+      auto [current, children_done] = stack.back();
+      stack.pop_back();
+      Node &node = nodes_[current];
+      if (node.axis < 0) {
+        node.first_leaf = static_cast<std::uint32_t>(leaves_.size());
+        node.end_leaf = node.first_leaf + 1;
+        for (VertexIndex v : node.points)
+          leaf_of_[v] = node.first_leaf;
+        leaves_.push_back(current);
+      } else if (children_done) {
+        node.first_leaf = nodes_[node.children[0]].first_leaf;
+        node.end_leaf = nodes_[node.children[1]].end_leaf;
+      } else {
+        stack.push_back({current, true});
+        stack.push_back({node.children[1], false});
+        stack.push_back({node.children[0], false});
+      }
+    }
+  }
+
+  const std::vector<Eigen::Vector3d> &points_;
+  std::vector<Node> nodes_;
+  std::vector<int> leaves_;
+  std::vector<std::uint32_t> leaf_of_;
+  int root_ = -1;
+  Eigen::Vector3d grid_low_ = Eigen::Vector3d::Zero(), grid_cell_ = Eigen::Vector3d::Ones();
+  int grid_ = 0;
+};
+
+/// Median nearest-neighbour distance from a few points of each bucket to
+/// the other points of that bucket (a bucket is big enough for this).
+double medianSpacing(const std::vector<Eigen::Vector3d> &points, BucketTree &tree) {
+  std::vector<double> distances;
+  for (int leaf : tree.leaves()) {
+    const std::vector<VertexIndex> &members = tree.nodes()[leaf].points;
+    if (members.size() < 2)
+      continue;
+    const std::size_t samples = std::min(spacing_samples_per_bucket, members.size());
+    for (std::size_t s = 0; s < samples; ++s) {
+      const VertexIndex query = members[s * members.size() / samples];
+      double nearest = std::numeric_limits<double>::infinity();
+      for (VertexIndex other : members)
+        if (other != query)
+          nearest = std::min(nearest, (points[other] - points[query]).squaredNorm());
+      distances.push_back(std::sqrt(nearest));
+    }
+  }
+  if (distances.empty())
+    return 0;
+  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+  return distances[distances.size() / 2];
+}
+
+/// Calls progress one at a time from whichever thread finished a unit.
+class ProgressReporter {
+public:
+  ProgressReporter(const Parameters &parameters, std::size_t total)
+      : callback_(parameters.progress), total_(total) {}
+  void unitDone() {
+    if (!callback_)
+      return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    callback_(++done_, total_);
+  }
+
+private:
+  const std::function<void(std::size_t, std::size_t)> &callback_;
+  std::size_t total_;
+  std::size_t done_ = 0;
+  std::mutex mutex_;
+};
+
+class BucketedMesher {
+public:
+  BucketedMesher(const std::vector<Eigen::Vector3d> &points,
+                 const std::vector<Eigen::Vector3f> *normals, const Parameters &parameters)
+      : points_(points), normals_(normals), parameters_(parameters),
+        tree_(points,
+              parameters.bucket_points > 0 ? parameters.bucket_points : default_bucket_points,
+              parameters.grid_buckets) {}
+
+  BucketedSurface run() {
+    std::vector<Node> &nodes = tree_.nodes();
+    const std::vector<int> &leaves = tree_.leaves();
+    std::vector<int> inner;
+    int max_depth = 0;
+    for (std::size_t i = 0; i < nodes.size(); ++i)
+      if (nodes[i].axis >= 0) {
+        inner.push_back(static_cast<int>(i));
+        max_depth = std::max(max_depth, nodes[i].depth);
+      }
+    ProgressReporter progress(parameters_, leaves.size() + inner.size());
+    surface_.statistics.buckets = leaves.size();
+    surface_.statistics.seam_zones = inner.size();
+
+    const double spacing = medianSpacing(points_, tree_);
+    const double estimated_d_med = d_med_per_spacing * spacing;
+    margin_ = (parameters_.rho + margin_context_in_d_med) * estimated_d_med;
+
+    tbb::task_arena arena(parameters_.num_threads > 0 ? parameters_.num_threads
+                                                      : tbb::task_arena::automatic);
+    Clock::time_point stage = Clock::now();
+    std::vector<BucketOutcome> leaf_outcomes(leaves.size());
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size(), 1),
+                        [&](const tbb::blocked_range<std::size_t> &range) {
+                          for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                            meshLeaf(nodes[leaves[i]], leaf_outcomes[i]);
+                            progress.unitDone();
+                          }
+                        });
+    });
+    std::vector<double> bucket_d_meds;
+    for (const BucketOutcome &outcome : leaf_outcomes) {
+      addTimings(outcome);
+      if (outcome.error.empty())
+        bucket_d_meds.push_back(outcome.d_med);
+      else
+        ++surface_.statistics.failed_units;
+    }
+    if (bucket_d_meds.empty())
+      throw ReconstructionError("no bucket could be meshed: " + leaf_outcomes.front().error);
+    std::nth_element(bucket_d_meds.begin(), bucket_d_meds.begin() + bucket_d_meds.size() / 2,
+                     bucket_d_meds.end());
+    surface_.d_med = bucket_d_meds[bucket_d_meds.size() / 2];
+    surface_.statistics.buckets_seconds = secondsSince(stage);
+
+    // Seams bottom-up: a zone's subtrees are complete when it is stitched,
+    // and zones of one depth are disjoint, so they run in parallel.
+    stage = Clock::now();
+    for (int depth = max_depth; depth >= 0; --depth) {
+      std::vector<int> level;
+      for (int index : inner)
+        if (nodes[index].depth == depth)
+          level.push_back(index);
+      std::vector<BucketOutcome> outcomes(level.size());
+      std::vector<std::size_t> zone_points(level.size(), 0);
+      arena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, level.size(), 1),
+                          [&](const tbb::blocked_range<std::size_t> &range) {
+                            for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                              zone_points[i] = stitch(nodes[level[i]], outcomes[i]);
+                              progress.unitDone();
+                            }
+                          });
+      });
+      for (std::size_t i = 0; i < level.size(); ++i) {
+        addTimings(outcomes[i]);
+        surface_.statistics.seam_points += zone_points[i];
+        surface_.statistics.seam_triangles += outcomes[i].triangles.size();
+        if (!outcomes[i].error.empty() && zone_points[i] >= 3)
+          ++surface_.statistics.failed_units;
+      }
+    }
+    surface_.triangles = std::move(nodes[tree_.root()].triangles);
+    // A seam that could not join two fixed fans at a vertex leaves a bow-tie.
+    std::vector<bool> every_vertex(points_.size(), true);
+    surface_.statistics.bow_tie_triangles_removed =
+        splitBowTies(surface_.triangles, points_.size(), every_vertex);
+    surface_.statistics.seams_seconds = secondsSince(stage);
+    return std::move(surface_);
+  }
+
+private:
+  BucketTask makeTask(const std::vector<VertexIndex> &members) const {
+    BucketTask task;
+    task.points.reserve(members.size());
+    for (VertexIndex v : members)
+      task.points.push_back(points_[v]);
+    if (normals_) {
+      task.normals.reserve(members.size());
+      for (VertexIndex v : members)
+        task.normals.push_back((*normals_)[v]);
+    }
+    return task;
+  }
+
+  static std::vector<Triangle> toGlobal(const std::vector<Triangle> &local,
+                                        const std::vector<VertexIndex> &members) {
+    std::vector<Triangle> global(local.size());
+    for (std::size_t t = 0; t < local.size(); ++t)
+      for (int k = 0; k < 3; ++k)
+        global[t][k] = members[local[t][k]];
+    return global;
+  }
+
+  /// A bucket: its points plus those within the margin around its region.
+  void meshLeaf(Node &leaf, BucketOutcome &outcome) {
+    const std::uint32_t leaf_id = leaf.first_leaf;
+    const std::vector<VertexIndex> members =
+        tree_.gather(leaf.region.expanded(margin_), [](VertexIndex) { return true; });
+    BucketTask task = makeTask(members);
+    task.core.resize(members.size());
+    for (std::size_t i = 0; i < members.size(); ++i)
+      task.core[i] = tree_.leafOf(members[i]) == leaf_id;
+    {
+      std::lock_guard<std::mutex> lock(statistics_mutex_);
+      surface_.statistics.margin_points += members.size() - leaf.points.size();
+    }
+    outcome = meshBucket(task, parameters_);
+    leaf.triangles = toGlobal(outcome.triangles, members);
+  }
+
+  /// The zone along node's split plane: the subtree's points within d_max
+  /// of the plane (core), and points of other subtrees within the margin
+  /// around the node's region. Triangles of the subtree that touch the core
+  /// are fixed; their corners outside the zone are frozen. Returns the
+  /// number of core points.
+  std::size_t stitch(Node &node, BucketOutcome &outcome) {
+    const double half_width = parameters_.rho * surface_.d_med;
+    Box slab = node.region.expanded(margin_);
+    slab.low[node.axis] = std::max(slab.low[node.axis], node.split - half_width);
+    slab.high[node.axis] = std::min(slab.high[node.axis], node.split + half_width);
+    const std::vector<VertexIndex> zone = tree_.gather(slab, [](VertexIndex) { return true; });
+    auto inZone = [&](VertexIndex v) { return std::binary_search(zone.begin(), zone.end(), v); };
+
+    std::vector<Triangle> subtree_triangles;
+    std::vector<Triangle> fixed;
+    std::vector<VertexIndex> frozen;
+    std::size_t core_points = 0;
+    for (VertexIndex v : zone)
+      core_points += tree_.inSubtree(v, node);
+    for (int child : node.children) {
+      for (const Triangle &triangle : nodes_()[child].triangles) {
+        bool touches = false;
+        for (VertexIndex v : triangle)
+          touches = touches || inZone(v);
+        if (!touches)
+          continue;
+        fixed.push_back(triangle);
+        for (VertexIndex v : triangle)
+          if (!inZone(v))
+            frozen.push_back(v);
+      }
+    }
+    std::sort(frozen.begin(), frozen.end());
+    frozen.erase(std::unique(frozen.begin(), frozen.end()), frozen.end());
+    std::vector<VertexIndex> members;
+    members.reserve(zone.size() + frozen.size());
+    std::merge(zone.begin(), zone.end(), frozen.begin(), frozen.end(), std::back_inserter(members));
+
+    std::vector<Triangle> added;
+    if (core_points >= 3) {
+      BucketTask task = makeTask(members);
+      task.d_med = surface_.d_med;
+      task.core.resize(members.size());
+      task.frozen.resize(members.size());
+      for (std::size_t i = 0; i < members.size(); ++i) {
+        const bool is_frozen = std::binary_search(frozen.begin(), frozen.end(), members[i]);
+        task.frozen[i] = is_frozen;
+        task.core[i] = !is_frozen && tree_.inSubtree(members[i], node);
+      }
+      auto localIndex = [&](VertexIndex v) {
+        return static_cast<VertexIndex>(std::lower_bound(members.begin(), members.end(), v) -
+                                        members.begin());
+      };
+      task.fixed_triangles.reserve(fixed.size());
+      for (const Triangle &triangle : fixed)
+        task.fixed_triangles.push_back(
+            {localIndex(triangle[0]), localIndex(triangle[1]), localIndex(triangle[2])});
+      outcome = meshBucket(task, parameters_);
+      added = toGlobal(outcome.triangles, members);
+    } else {
+      outcome.error = "too few points";
+    }
+
+    // The subtree's triangles, then the seam's, in a fixed order.
+    std::vector<Triangle> &merged = node.triangles;
+    for (int child : node.children) {
+      std::vector<Triangle> &part = nodes_()[child].triangles;
+      merged.insert(merged.end(), part.begin(), part.end());
+      std::vector<Triangle>().swap(part);
+    }
+    merged.insert(merged.end(), added.begin(), added.end());
+    return core_points;
+  }
+
+  std::vector<Node> &nodes_() { return tree_.nodes(); }
+
+  void addTimings(const BucketOutcome &outcome) {
+    surface_.delaunay_seconds += outcome.delaunay_seconds;
+    surface_.scaffold_seconds += outcome.scaffold_seconds;
+    surface_.greedy_seconds += outcome.greedy_seconds;
+  }
+
+  const std::vector<Eigen::Vector3d> &points_;
+  const std::vector<Eigen::Vector3f> *normals_;
+  const Parameters &parameters_;
+  BucketTree tree_;
+  double margin_ = 0;
+  BucketedSurface surface_;
+  std::mutex statistics_mutex_;
+};
+
+} // namespace
+
+BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters) {
+  BucketOutcome outcome;
+  if (task.points.size() < 3) {
+    outcome.error = "fewer than 3 points";
+    return outcome;
+  }
+  try {
+    const Clock::time_point start = Clock::now();
+    ScaffoldOptions options;
+    options.rho = parameters.rho;
+    options.num_threads = 1;
+    options.normals = parameters.use_normals && !task.normals.empty() ? &task.normals : nullptr;
+    options.normal_weight = parameters.normal_weight;
+    options.d_med = task.d_med;
+    options.fixed_triangles = task.fixed_triangles.empty() ? nullptr : &task.fixed_triangles;
+    options.frozen_vertices = task.frozen.empty() ? nullptr : &task.frozen;
+    const MedialScaffold scaffold = buildMedialScaffold(task.points, options);
+    outcome.d_med = scaffold.d_med;
+    outcome.delaunay_seconds = scaffold.delaunay_seconds;
+    outcome.scaffold_seconds = secondsSince(start) - scaffold.delaunay_seconds;
+
+    const Clock::time_point greedy_start = Clock::now();
+    GreedyMesher mesher(scaffold, task.points, parameters);
+    mesher.run();
+    for (const Triangle &triangle : mesher.triangles(false))
+      if (task.core[triangle[0]] && task.core[triangle[1]] && task.core[triangle[2]])
+        outcome.triangles.push_back(triangle);
+    outcome.greedy_seconds = secondsSince(greedy_start);
+  } catch (const ReconstructionError &error) {
+    outcome.error = error.what();
+    outcome.triangles.clear();
+  }
+  return outcome;
+}
+
+bool usesBuckets(std::size_t points, const Parameters &parameters) {
+  if (parameters.grid_buckets > 0)
+    return true;
+  if (parameters.bucket_points > 0)
+    return points > parameters.bucket_points;
+  return points > automatic_bucketing_threshold;
+}
+
+BucketedSurface meshInBuckets(const std::vector<Eigen::Vector3d> &points,
+                              const std::vector<Eigen::Vector3f> *normals,
+                              const Parameters &parameters) {
+  return BucketedMesher(points, normals, parameters).run();
+}
+
+} // namespace pcl_ms
