@@ -19,6 +19,14 @@ PACKAGES=(
   libtbb-dev
   libgmp-dev
   libmpfr-dev
+  # Off-screen pictures (apps/common/render_mesh.cpp): Debian's VTK draws
+  # through GLX only, so headless machines get a private Xvfb, and Mesa's
+  # software OpenGL (llvmpipe, loaded at run time) does the drawing. libpng
+  # checks pictures before VTK reads them.
+  xvfb
+  libgl1-mesa-dri
+  libglx-mesa0
+  libpng-dev
 )
 
 missing=()

@@ -2,7 +2,9 @@
 //
 // Off-screen pictures of triangle meshes for pcl_ms_compare and the README:
 // shaded faces, boundary edges in blue and non-manifold edges in red, as the
-// paper draws them. Works without a display.
+// paper draws them. Works without a display: with no usable DISPLAY, the
+// first render starts a private Xvfb (Debian package xvfb) that ends with
+// the process. Renders may come from any thread; they run one at a time.
 #pragma once
 
 #include <pcl_ms/types.h>
@@ -22,7 +24,10 @@ struct RenderView {
   double distance = 1; // camera distance from look_at
 };
 
-// A view that frames the bounding box of the points from a fixed oblique angle.
+// A view that frames the points from a fixed oblique direction: from the
+// front left and a little below, with y up (the Stanford scans' frame), so
+// the bunny's base holes show. Pass the input cloud, not each method's mesh,
+// so every picture of a comparison gets the same camera.
 RenderView viewFramingPoints(const std::vector<Eigen::Vector3d> &points);
 
 struct RenderOptions {
@@ -31,12 +36,15 @@ struct RenderOptions {
   std::string caption; // drawn at the top of the picture when not empty
 };
 
-// Writes a PNG. Returns false with a one-line reason in `error` when it cannot.
+// Writes a PNG (RGB, white background). Triangles with a missing or
+// non-finite vertex are skipped. Returns false with a one-line reason in
+// `error` when it cannot render or write.
 bool renderMeshPng(const std::vector<Eigen::Vector3d> &vertices,
                    const std::vector<pcl_ms::Triangle> &triangles, const RenderView &view,
                    const RenderOptions &options, const std::string &png_path, std::string &error);
 
-// Puts PNGs (same height) next to each other into one PNG.
+// Puts PNGs (same height and pixel format) next to each other, left to
+// right, into one PNG. Returns false with a one-line reason in `error`.
 bool composeSideBySide(const std::vector<std::string> &png_paths, const std::string &output_path,
                        std::string &error);
 
