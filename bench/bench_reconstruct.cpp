@@ -3,7 +3,10 @@
 // surface reconstruction (AFSR) and a bare 3-D Delaunay triangulation on the
 // bunny vertices and on uniform samplings of the bunny reference surface.
 // Every method runs single-threaded in its own forked child so that its peak
-// resident memory (ru_maxrss from wait4) is not mixed with the others'.
+// resident memory (VmHWM) is not mixed with the others'.
+#include "child_process.h"
+#include "mesh_report.h"
+
 #include <pcl_ms/io.h>
 #include <pcl_ms/reconstruct.h>
 
@@ -14,11 +17,6 @@
 #include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 
-#include <sys/resource.h>
-#include <sys/types.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
 #include <charconv>
@@ -28,7 +26,6 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
-#include <exception>
 #include <fstream>
 #include <functional>
 #include <random>
@@ -147,56 +144,16 @@ Run runInChild(const std::string &name, const std::function<Measurement(const In
                const Input &input) {
   Run run;
   run.method = name;
-  std::fflush(stdout);
-  int channel[2];
-  if (pipe(channel) != 0) {
-    std::snprintf(run.measurement.message, sizeof(run.measurement.message), "pipe: %s",
-                  std::strerror(errno));
-    return run;
-  }
-  const pid_t child = fork();
-  if (child < 0) {
-    std::snprintf(run.measurement.message, sizeof(run.measurement.message), "fork: %s",
-                  std::strerror(errno));
-    close(channel[0]);
-    close(channel[1]);
-    return run;
-  }
-  if (child == 0) {
-    close(channel[0]);
-    Measurement measurement;
-    try {
-      measurement = method(input);
-    } catch (const std::exception &exception) {
-      measurement.ok = false;
-      std::snprintf(measurement.message, sizeof(measurement.message), "%s", exception.what());
-    }
-    const ssize_t written = write(channel[1], &measurement, sizeof(measurement));
-    _exit(written == static_cast<ssize_t>(sizeof(measurement)) ? 0 : 1);
-  }
-  close(channel[1]);
-  std::size_t received = 0;
-  auto *bytes = reinterpret_cast<char *>(&run.measurement);
-  while (received < sizeof(Measurement)) {
-    const ssize_t count = read(channel[0], bytes + received, sizeof(Measurement) - received);
-    if (count <= 0)
-      break;
-    received += static_cast<std::size_t>(count);
-  }
-  close(channel[0]);
-  int status = 0;
-  rusage usage{};
-  wait4(child, &status, 0, &usage);
-  run.peak_mb = static_cast<double>(usage.ru_maxrss) / 1024.0; // ru_maxrss is in KiB
-  if (received != sizeof(Measurement)) {
-    run.measurement = Measurement();
-    if (WIFSIGNALED(status))
-      std::snprintf(run.measurement.message, sizeof(run.measurement.message), "killed by signal %d",
-                    WTERMSIG(status));
-    else
-      std::snprintf(run.measurement.message, sizeof(run.measurement.message),
-                    "exited with status %d", WEXITSTATUS(status));
-  }
+  const pcl_ms_tools::ChildOutcome outcome = pcl_ms_tools::runInChild([&] {
+    const Measurement measurement = method(input);
+    return std::string(reinterpret_cast<const char *>(&measurement), sizeof(measurement));
+  });
+  run.peak_mb = outcome.peak_mb;
+  if (outcome.ok && outcome.payload.size() == sizeof(Measurement))
+    std::memcpy(&run.measurement, outcome.payload.data(), sizeof(Measurement));
+  else
+    std::snprintf(run.measurement.message, sizeof(run.measurement.message), "%s",
+                  outcome.ok ? "malformed result" : outcome.error.c_str());
   return run;
 }
 
@@ -259,15 +216,7 @@ Input sampleSurface(const std::vector<Eigen::Vector3d> &vertices,
 
 // --- Output -----------------------------------------------------------------
 
-std::string withThousands(std::uint64_t value) {
-  std::string digits = std::to_string(value), out;
-  for (std::size_t i = 0; i < digits.size(); ++i) {
-    if (i > 0 && (digits.size() - i) % 3 == 0)
-      out += ',';
-    out += digits[i];
-  }
-  return out;
-}
+using pcl_ms_tools::withThousands;
 
 const Run *findRun(const std::vector<Run> &runs, const std::string &method) {
   for (const Run &run : runs)
@@ -437,7 +386,7 @@ int main(int argc, char **argv) {
     return fail(error);
 
   std::printf("bench_reconstruct: single-threaded; each method in a forked child, peak = its "
-              "ru_maxrss.\n'above input' subtracts the peak of a child that only holds the "
+              "VmHWM.\n'above input' subtracts the peak of a child that only holds the "
               "input. For pcl_ms, the process peak after each stage is printed too.\n");
   for (std::size_t i = 0; i <= sizes.size(); ++i) {
     // Sample each size only when its turn comes, so the parent stays small.

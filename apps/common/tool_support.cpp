@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "tool_support.h"
+
+#include <pcl/conversions.h>
+
+#include <cmath>
+#include <cstdio>
+
+namespace pcl_ms_tools {
+
+int fail(int code, const std::string &reason) {
+  std::fflush(stdout);
+  std::fprintf(stderr, "error: %s\n", reason.c_str());
+  return code;
+}
+
+std::size_t finitePoints(const pcl::PCLPointCloud2 &cloud, pcl::PointCloud<pcl::PointXYZ> &points) {
+  pcl::PointCloud<pcl::PointXYZ> all;
+  {
+    SilencePclMessages silence; // fields other than x, y, z are expected to be missing
+    pcl::fromPCLPointCloud2(cloud, all);
+  }
+  points.clear();
+  points.reserve(all.size());
+  for (const pcl::PointXYZ &p : all)
+    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))
+      points.push_back(p);
+  return all.size() - points.size();
+}
+
+std::vector<Eigen::Vector3d> positions(const pcl::PointCloud<pcl::PointXYZ> &points) {
+  std::vector<Eigen::Vector3d> result;
+  result.reserve(points.size());
+  for (const pcl::PointXYZ &p : points)
+    result.emplace_back(p.x, p.y, p.z);
+  return result;
+}
+
+} // namespace pcl_ms_tools
