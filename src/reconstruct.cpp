@@ -55,7 +55,9 @@ double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-/// The process's peak resident set so far (VmHWM), or 0 where unknown.
+/// The process's peak resident set so far (VmHWM), or 0 where unknown. The
+/// kernel syncs per-thread counters lazily, so after worker threads a later
+/// reading can be a little lower: callers keep the running maximum.
 std::size_t peakResidentBytes() {
   std::ifstream status("/proc/self/status");
   std::string line;
@@ -252,7 +254,8 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
     result.timings.delaunay = bucketed.delaunay_seconds;
     result.timings.scaffold = bucketed.scaffold_seconds;
     result.timings.greedy = bucketed.greedy_seconds;
-    result.peak_memory.scaffold = result.peak_memory.greedy = peakResidentBytes();
+    result.peak_memory.scaffold = result.peak_memory.greedy =
+        std::max(result.peak_memory.prepare, peakResidentBytes());
   } else {
     stage = Clock::now();
     ScaffoldOptions options;
@@ -271,7 +274,7 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
     result.candidates_type2 = scaffold.type2;
     result.candidates_type3 = scaffold.type3;
     result.candidates_oversize = scaffold.oversize;
-    result.peak_memory.scaffold = peakResidentBytes();
+    result.peak_memory.scaffold = std::max(result.peak_memory.prepare, peakResidentBytes());
 
     stage = Clock::now();
     GreedyMesher mesher(scaffold, prepared.positions, parameters);
@@ -282,7 +285,7 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
     result.cleanup_undone = mesher.statistics().cleanup_undone;
     result.swapped_pairs = mesher.statistics().swapped_pairs;
     result.timings.greedy = secondsSince(stage);
-    result.peak_memory.greedy = peakResidentBytes();
+    result.peak_memory.greedy = std::max(result.peak_memory.scaffold, peakResidentBytes());
   }
 
   stage = Clock::now();
@@ -310,7 +313,7 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
   result.component_orientable = std::move(surface.component_orientable);
   result.holes_filled = surface.holes_filled;
   result.timings.finish = secondsSince(stage);
-  result.peak_memory.finish = peakResidentBytes();
+  result.peak_memory.finish = std::max(result.peak_memory.greedy, peakResidentBytes());
   result.timings.total = secondsSince(start);
   return result;
 }
