@@ -274,30 +274,35 @@ std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen:
 
 namespace {
 
-/// Two triangles sharing a manifold edge, and how much the surface bends there.
+/// Two triangles sharing a manifold edge, and how much the surface bends
+/// there (computed only where orientation needs it).
 struct ManifoldPair {
   std::uint32_t first, second;
+  VertexIndex a, b; // the shared edge
   double bending;
 };
 
-std::vector<ManifoldPair> manifoldPairs(const std::vector<Triangle> &triangles,
-                                        const std::vector<Eigen::Vector3d> &points) {
+std::vector<ManifoldPair> manifoldPairs(const std::vector<Triangle> &triangles) {
   const std::vector<EdgeUse> uses = edgeUses(triangles);
   std::vector<ManifoldPair> pairs;
   forEachEdge(uses, [&](EdgeKey key, std::size_t first, std::size_t count) {
-    if (count != 2)
-      return;
-    const VertexIndex a = lowVertex(key), b = highVertex(key);
-    auto apex = [&](std::uint32_t t) {
-      for (VertexIndex v : triangles[t])
-        if (v != a && v != b)
-          return v;
-      return a;
-    };
-    const std::uint32_t t = uses[first].triangle, u = uses[first + 1].triangle;
-    pairs.push_back({t, u, bendingAngle(points[a], points[b], points[apex(t)], points[apex(u)])});
+    if (count == 2)
+      pairs.push_back(
+          {uses[first].triangle, uses[first + 1].triangle, lowVertex(key), highVertex(key), 0});
   });
   return pairs;
+}
+
+void computeBending(ManifoldPair &pair, const std::vector<Triangle> &triangles,
+                    const std::vector<Eigen::Vector3d> &points) {
+  auto apex = [&](std::uint32_t t) {
+    for (VertexIndex v : triangles[t])
+      if (v != pair.a && v != pair.b)
+        return v;
+    return pair.a;
+  };
+  pair.bending = bendingAngle(points[pair.a], points[pair.b], points[apex(pair.first)],
+                              points[apex(pair.second)]);
 }
 
 /// Whether t and u run their shared edge in opposite directions.
@@ -421,7 +426,7 @@ std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
                                             std::vector<std::uint32_t> &triangle_component,
                                             std::vector<bool> &component_orientable) {
   const std::uint32_t unvisited = std::numeric_limits<std::uint32_t>::max();
-  const std::vector<ManifoldPair> pairs = manifoldPairs(triangles, points);
+  std::vector<ManifoldPair> pairs = manifoldPairs(triangles);
   std::vector<std::uint32_t> offsets(triangles.size() + 1, 0);
   for (const ManifoldPair &pair : pairs) {
     ++offsets[pair.first + 1];
@@ -437,19 +442,22 @@ std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
       incident[cursor[pairs[p].second]++] = p;
     }
   }
+  // Sets the orientation of `next` from its already oriented neighbour.
+  auto orientAcross = [&](const ManifoldPair &pair, std::uint32_t component) {
+    const bool first_known = triangle_component[pair.first] == component;
+    const std::uint32_t known = first_known ? pair.first : pair.second;
+    const std::uint32_t next = first_known ? pair.second : pair.first;
+    if (!consistentlyOriented(triangles[known], triangles[next]))
+      std::swap(triangles[next][1], triangles[next][2]);
+    triangle_component[next] = component;
+    return next;
+  };
 
-  // Orientation spreads across the flattest edges first (a maximum spanning
-  // tree on flatness): where a component cannot be oriented, the edges left
-  // inconsistent are then its most bent ones, i.e. where the twist is.
-  using Step = std::pair<double, std::uint32_t>; // bending, pair index
-  std::priority_queue<Step, std::vector<Step>, std::greater<Step>> frontier;
+  // A consistent orientation, where one exists, is the same whatever order
+  // it spreads in: breadth first, each component from its first triangle.
   triangle_component.assign(triangles.size(), unvisited);
   component_orientable.clear();
   std::vector<std::vector<std::uint32_t>> members;
-  auto spreadFrom = [&](std::uint32_t t) {
-    for (std::uint32_t i = offsets[t]; i < offsets[t + 1]; ++i)
-      frontier.push({pairs[incident[i]].bending, incident[i]});
-  };
   for (std::uint32_t seed = 0; seed < triangles.size(); ++seed) {
     if (triangle_component[seed] != unvisited)
       continue;
@@ -457,30 +465,59 @@ std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
     component_orientable.push_back(true);
     members.push_back({seed});
     triangle_component[seed] = component;
+    std::vector<std::uint32_t> &queue = members.back();
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const std::uint32_t t = queue[head];
+      for (std::uint32_t i = offsets[t]; i < offsets[t + 1]; ++i) {
+        const ManifoldPair &pair = pairs[incident[i]];
+        if (triangle_component[pair.first] == unvisited ||
+            triangle_component[pair.second] == unvisited)
+          queue.push_back(orientAcross(pair, component));
+      }
+    }
+  }
+  for (const ManifoldPair &pair : pairs)
+    if (!consistentlyOriented(triangles[pair.first], triangles[pair.second]))
+      component_orientable[triangle_component[pair.first]] = false;
+
+  // Where none exists, orientation spreads again across the flattest edges
+  // first (a maximum spanning tree on flatness), so that the edges left
+  // inconsistent are the component's most bent ones, i.e. where the twist is.
+  using Step = std::pair<double, std::uint32_t>; // bending, pair index
+  std::priority_queue<Step, std::vector<Step>, std::greater<Step>> frontier;
+  for (std::uint32_t component = 0; component < members.size(); ++component) {
+    if (component_orientable[component])
+      continue;
+    for (std::uint32_t t : members[component])
+      for (std::uint32_t i = offsets[t]; i < offsets[t + 1]; ++i)
+        computeBending(pairs[incident[i]], triangles, points);
+    const std::uint32_t seed = members[component].front();
+    for (std::uint32_t t : members[component])
+      triangle_component[t] = unvisited;
+    members[component] = {seed};
+    triangle_component[seed] = component;
+    auto spreadFrom = [&](std::uint32_t t) {
+      for (std::uint32_t i = offsets[t]; i < offsets[t + 1]; ++i)
+        frontier.push({pairs[incident[i]].bending, incident[i]});
+    };
     spreadFrom(seed);
     while (!frontier.empty()) {
       const ManifoldPair &pair = pairs[frontier.top().second];
       frontier.pop();
-      const bool first_known = triangle_component[pair.first] != unvisited;
-      const bool second_known = triangle_component[pair.second] != unvisited;
-      if (first_known && second_known)
+      if (triangle_component[pair.first] != unvisited &&
+          triangle_component[pair.second] != unvisited)
         continue;
-      const std::uint32_t known = first_known ? pair.first : pair.second;
-      const std::uint32_t next = first_known ? pair.second : pair.first;
-      if (!consistentlyOriented(triangles[known], triangles[next]))
-        std::swap(triangles[next][1], triangles[next][2]);
-      triangle_component[next] = component;
-      members.back().push_back(next);
+      const std::uint32_t next = orientAcross(pair, component);
+      members[component].push_back(next);
       spreadFrom(next);
     }
   }
   std::vector<std::uint32_t> sharply_bent_conflicts;
   for (const ManifoldPair &pair : pairs)
-    if (!consistentlyOriented(triangles[pair.first], triangles[pair.second])) {
-      component_orientable[triangle_component[pair.first]] = false;
-      if (pair.bending > max_untwist_bending)
-        sharply_bent_conflicts.push_back(pair.first);
-    }
+    if (!component_orientable[triangle_component[pair.first]] &&
+        !consistentlyOriented(triangles[pair.first], triangles[pair.second]) &&
+        pair.bending > max_untwist_bending)
+      sharply_bent_conflicts.push_back(pair.first);
   for (std::uint32_t component = 0; component < members.size(); ++component) {
     if (!component_orientable[component])
       continue;

@@ -25,9 +25,38 @@ struct CheaperFirst {
   }
 };
 
-using Queue =
-    boost::heap::d_ary_heap<QueueEntry, boost::heap::arity<4>, boost::heap::mutable_<true>,
-                            boost::heap::compare<CheaperFirst>>;
+/// Boost's contiguous d-ary heap without handles: a candidate whose cost
+/// changes is pushed again and its outdated entry skipped when it surfaces
+/// (lazy deletion). Handle updates in a mutable heap cost a pointer chase
+/// per access; this was the greedy's main cost.
+class CandidateQueue {
+public:
+  void push(const QueueEntry &entry) { heap_.push(entry); }
+  bool empty() const { return heap_.empty(); }
+  const QueueEntry &top() const { return heap_.top(); }
+  void pop() { heap_.pop(); }
+  std::size_t size() const { return heap_.size(); }
+
+  /// Drops the outdated entries.
+  template <typename IsCurrent> void compact(const IsCurrent &is_current) {
+    std::vector<QueueEntry> current;
+    for (auto it = heap_.begin(); it != heap_.end(); ++it)
+      if (is_current(*it))
+        current.push_back(*it);
+    heap_.clear();
+    heap_.reserve(current.size());
+    for (const QueueEntry &entry : current)
+      heap_.push(entry);
+  }
+
+private:
+  boost::heap::d_ary_heap<QueueEntry, boost::heap::arity<4>, boost::heap::compare<CheaperFirst>>
+      heap_;
+};
+
+// Outdated entries may grow the heap to twice the queued candidates plus
+// this before it is compacted.
+constexpr std::size_t compaction_slack = 1 << 16;
 
 // An undone triangle is re-queued at most this often, so that two candidates
 // whose costs keep crossing cannot undo each other forever.
@@ -159,9 +188,12 @@ private:
   }
 
   void refreshCost(CandidateIndex t) {
-    states_[t].cost = static_cast<float>(freshCost(t));
+    const float cost = static_cast<float>(freshCost(t));
+    if (cost == states_[t].cost)
+      return;
+    states_[t].cost = cost;
     if (isQueued(t) && !isWaitingForQueue2(t))
-      queueOf(states_[t].state).update(states_[t].handle, QueueEntry{states_[t].cost, t});
+      enqueue(t, states_[t].state);
   }
 
   // ---- queues ------------------------------------------------------------
@@ -173,13 +205,27 @@ private:
   bool isQueued(CandidateIndex t) const {
     return states_[t].state == State::queue1 || states_[t].state == State::queue2;
   }
-  Queue &queueOf(State state) { return state == State::queue1 ? queue1_ : queue2_; }
+  int queueNumber(State state) const { return state == State::queue1 ? 0 : 1; }
+
+  bool isCurrent(const QueueEntry &entry, State queue) const {
+    const CandidateState &state = states_[entry.candidate];
+    return state.state == queue && state.cost == entry.cost;
+  }
+
+  /// Puts t's current cost on the heap of `queue` (its state already).
+  void enqueue(CandidateIndex t, State queue) {
+    CandidateQueue &heap = queues_[queueNumber(queue)];
+    heap.push(QueueEntry{states_[t].cost, t});
+    if (heap.size() > 2 * queued_[queueNumber(queue)] + compaction_slack)
+      heap.compact([&](const QueueEntry &entry) { return isCurrent(entry, queue); });
+  }
 
   void push(CandidateIndex t, State queue) {
     states_[t].state = queue;
     if (queue == State::queue2 && !queue2_built_)
       return; // queued when pass 2 starts
-    states_[t].handle = queueOf(queue).push(QueueEntry{states_[t].cost, t});
+    ++queued_[queueNumber(queue)];
+    enqueue(t, queue);
   }
 
   /// Q2 waits through pass 1 untouched (most of it is type III far from the
@@ -198,15 +244,20 @@ private:
       }
       states_[t].context = contextFromScratch(t);
       states_[t].cost = static_cast<float>(freshCost(t));
-      states_[t].handle = queue2_.push(QueueEntry{states_[t].cost, t});
+      ++queued_[1];
+      enqueue(t, State::queue2);
     }
   }
 
   void runPass(State queue_state, PassStatistics &statistics) {
-    Queue &queue = queueOf(queue_state);
+    CandidateQueue &queue = queues_[queueNumber(queue_state)];
     while (!queue.empty()) {
-      const CandidateIndex t = queue.top().candidate;
+      const QueueEntry entry = queue.top();
       queue.pop();
+      if (!isCurrent(entry, queue_state))
+        continue;
+      const CandidateIndex t = entry.candidate;
+      --queued_[queueNumber(queue_state)];
       states_[t].state = State::idle;
       ++statistics.popped;
       decide(t, queue_state, statistics);
@@ -478,8 +529,8 @@ private:
         states_[old].state = State::dropped;
       }
       for (CandidateIndex replacement : {abd, bcd}) {
-        if (isQueued(replacement))
-          queueOf(states_[replacement].state).erase(states_[replacement].handle);
+        if (isQueued(replacement)) // its heap entry is outdated from now on
+          --queued_[queueNumber(states_[replacement].state)];
         mesh_.add(replacement);
         states_[replacement].state = State::accepted;
         propagateContext(replacement, +1.0);
@@ -582,8 +633,7 @@ private:
   // are visited in cost order, i.e. all over memory, so one cache line each.
   struct CandidateState {
     double context = 0; // sum of eps2 from accepted neighbours
-    Queue::handle_type handle;
-    float cost = 0; // current cost: (base + context) clamped at 0, times delays
+    float cost = 0;     // current cost: (base + context) clamped at 0, times delays
     State state = State::idle;
     std::uint8_t incidence_delays = 0, ranking_delays = 0, undos = 0;
   };
@@ -592,7 +642,8 @@ private:
   std::vector<bool> multi_fan_vertex_;
   std::vector<bool> may_have_several_fans_;
   std::vector<double> delay_multiplier_;
-  Queue queue1_, queue2_;
+  CandidateQueue queues_[2];       // Q1, Q2
+  std::size_t queued_[2] = {0, 0}; // candidates whose state is that queue
   bool queue2_built_ = false;
 };
 
