@@ -22,6 +22,8 @@
 #include <utility>
 #include <vector>
 
+#include <unistd.h>
+
 namespace {
 
 using pcl::console::print_highlight;
@@ -251,23 +253,31 @@ void printReport(const pcl_ms::Result &result, double load_ms, double save_ms) {
   }
 }
 
-/// Buckets and seams done, elapsed time and a linear estimate of the rest,
-/// rewritten in place on stderr.
+/// Buckets and seams done, elapsed time and a linear estimate of the rest:
+/// rewritten in place on a terminal, else one line a second.
 class ProgressLine {
 public:
-  void operator()(std::size_t done, std::size_t total) const {
-    const double elapsed =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    const double left = done > 0 ? elapsed * static_cast<double>(total - done) / done : 0;
-    std::fprintf(stderr, "\r  buckets and seams %zu/%zu, %.1f s elapsed, about %.0f s left   ",
-                 done, total, elapsed, left);
-    if (done == total)
+  void operator()(std::size_t done, std::size_t total) {
+    const auto now = std::chrono::steady_clock::now();
+    if (!terminal_ && done != total && now - last_line_ < std::chrono::seconds(1))
+      return;
+    last_line_ = now;
+    if (first_) // the progress starts below the "Reconstructing" line
       std::fprintf(stderr, "\n");
+    first_ = false;
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    const double left = done > 0 ? elapsed * static_cast<double>(total - done) / done : 0;
+    std::fprintf(stderr, "%s  buckets and seams %zu/%zu, %.1f s elapsed, about %.0f s left%s",
+                 terminal_ ? "\r" : "", done, total, elapsed, left,
+                 terminal_ && done != total ? "   " : "\n");
     std::fflush(stderr);
   }
 
 private:
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point last_line_ = start_;
+  bool terminal_ = isatty(fileno(stderr)) != 0;
+  bool first_ = true;
 };
 
 int fail(ExitCode code, const std::string &reason) {
@@ -338,8 +348,10 @@ int run(int argc, char **argv) {
     print_value("%d ", options.threads);
   }
   timer.tic();
-  if (verbose)
+  if (verbose) {
+    std::fflush(stdout); // the progress line goes to stderr
     parameters.progress = ProgressLine();
+  }
   pcl::PolygonMesh mesh;
   pcl_ms::Result result;
   const bool reconstructed =

@@ -6,6 +6,7 @@
 // resident memory (VmHWM) is not mixed with the others'.
 #include "child_process.h"
 #include "mesh_report.h"
+#include "surface_sampling.h"
 
 #include <pcl_ms/io.h>
 #include <pcl_ms/reconstruct.h>
@@ -28,7 +29,6 @@
 #include <ctime>
 #include <fstream>
 #include <functional>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -177,40 +177,16 @@ bool loadBunnyVertices(const std::string &path, Input &input, std::string &error
   return true;
 }
 
-/// Uniform samples of the surface: triangles drawn in proportion to their
-/// area, points uniform inside them. The seed depends only on the size so a
+/// Uniform samples of the surface. The seed depends only on the size so a
 /// size gives the same points whichever other sizes are run.
 Input sampleSurface(const std::vector<Eigen::Vector3d> &vertices,
                     const std::vector<pcl_ms::Triangle> &triangles, std::size_t size) {
-  std::vector<double> cumulative_area(triangles.size());
-  double total = 0;
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
-    const Eigen::Vector3d &a = vertices[triangles[t][0]];
-    total += 0.5 * (vertices[triangles[t][1]] - a).cross(vertices[triangles[t][2]] - a).norm();
-    cumulative_area[t] = total;
-  }
-  std::mt19937 random(20240521u + static_cast<std::uint32_t>(size));
-  std::uniform_real_distribution<double> area(0.0, total), unit(0.0, 1.0);
+  const std::uint32_t seed = 20240521u + static_cast<std::uint32_t>(size);
   Input input;
-  input.name = "bun_zipper surface sample, seed " + std::to_string(20240521u + size);
+  input.name = "bun_zipper surface sample, seed " + std::to_string(seed);
   input.xyz.reserve(3 * size);
-  for (std::size_t i = 0; i < size; ++i) {
-    const auto chosen =
-        std::upper_bound(cumulative_area.begin(), cumulative_area.end(), area(random)) -
-        cumulative_area.begin();
-    const pcl_ms::Triangle &triangle =
-        triangles[std::min<std::size_t>(static_cast<std::size_t>(chosen), triangles.size() - 1)];
-    double u = unit(random), v = unit(random);
-    if (u + v > 1) { // fold the far half of the square back onto the triangle
-      u = 1 - u;
-      v = 1 - v;
-    }
-    const Eigen::Vector3d &a = vertices[triangle[0]];
-    const Eigen::Vector3d point =
-        a + u * (vertices[triangle[1]] - a) + v * (vertices[triangle[2]] - a);
-    for (int k = 0; k < 3; ++k)
-      input.xyz.push_back(static_cast<float>(point[k]));
-  }
+  for (const Eigen::Vector3f &point : pcl_ms_tools::sampleSurface(vertices, triangles, size, seed))
+    input.xyz.insert(input.xyz.end(), {point.x(), point.y(), point.z()});
   return input;
 }
 

@@ -811,6 +811,23 @@ TEST_F(App, OptionsAndQuietMode) {
   EXPECT_TRUE(fs::exists(path("out.ply")));
 }
 
+TEST_F(App, BucketsWithProgressAndSummary) {
+  const std::string files = "'" + kDataDir + "/bunny.pcd' '" + path("out.ply") + "'";
+  ASSERT_EQ(run(files + " -bucket_points 10000 -threads 2"), 0) << stderr_;
+  // 35,947 points: 4 buckets and 3 seams, reported on stderr as they finish.
+  EXPECT_TRUE(contains(stderr_, "buckets and seams 7/7")) << stderr_;
+  EXPECT_TRUE(contains(stdout_, "seam triangles")) << stdout_;
+  EXPECT_TRUE(fs::exists(path("out.ply")));
+
+  ASSERT_EQ(run(files + " -grid 2 -q"), 0) << stderr_;
+  EXPECT_TRUE(stdout_.empty()) << stdout_;
+  EXPECT_TRUE(stderr_.empty()) << stderr_;
+
+  expectFailure(files + " -bucket_points 50", "bucket size");
+  expectFailure(files + " -bucket_points many", "-bucket_points");
+  expectFailure(files + " -grid -2", "grid");
+}
+
 TEST_F(App, HelpExitsCleanly) {
   EXPECT_EQ(run("-h"), 0);
   EXPECT_TRUE(contains(stdout_, "-rho")) << stdout_;
