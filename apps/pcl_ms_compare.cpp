@@ -36,6 +36,7 @@ using namespace pcl_ms_tools;
 struct Options {
   std::string input, reference, out_dir = "compare_out";
   std::vector<Method> methods = allMethods();
+  int picture_size = 800; // pixels, width and height of each method's picture
   bool quiet = false;
   bool help = false;
 };
@@ -43,13 +44,15 @@ struct Options {
 void printHelp(const char *program) {
   std::printf(
       "Meshes a point cloud with pcl_ms and three other methods and compares the results.\n\n"
-      "Usage: %s input [-gt reference_mesh] [-out DIR] [-methods list] [-q]\n\n"
+      "Usage: %s input [-gt reference_mesh] [-out DIR] [-methods list] [-picture_size N] [-q]\n\n"
       "  input         point cloud: .pcd, .ply, .xyz or .txt\n"
       "  -gt FILE      reference surface (.ply, .obj, .off, .vtk): adds triangle recall and\n"
       "                precision (vertices matched by position), distances and F-scores\n"
       "  -out DIR      output directory, created if missing (default compare_out)\n"
       "  -methods L    comma-separated subset of pcl_ms (or ours), gp3, poisson, afsr\n"
       "                (default: all four)\n"
+      "  -picture_size N\n"
+      "                width and height of each method's picture in pixels (default 800)\n"
       "  -q            quiet: no progress, only warnings and errors\n"
       "  -h            this help\n\n"
       "Writes results.md, results.csv, <method>.ply, <method>.png and side_by_side.png.\n"
@@ -84,6 +87,20 @@ bool parseMethods(const std::string &text, std::vector<Method> &methods, std::st
   return true;
 }
 
+bool parsePictureSize(const std::string &text, int &size, std::string &error) {
+  std::size_t used = 0;
+  try {
+    size = std::stoi(text, &used);
+  } catch (const std::exception &) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || size < 64 || size > 4096) {
+    error = "-picture_size: '" + text + "' is not a whole number from 64 to 4096";
+    return false;
+  }
+  return true;
+}
+
 bool parseArguments(int argc, char **argv, Options &options, std::string &error) {
   std::vector<std::string> positional;
   for (int i = 1; i < argc; ++i) {
@@ -92,18 +109,23 @@ bool parseArguments(int argc, char **argv, Options &options, std::string &error)
       options.help = true;
     } else if (argument == "-q") {
       options.quiet = true;
-    } else if (argument == "-gt" || argument == "-out" || argument == "-methods") {
+    } else if (argument == "-gt" || argument == "-out" || argument == "-methods" ||
+               argument == "-picture_size") {
       if (i + 1 >= argc) {
         error = argument + " needs a value";
         return false;
       }
       const std::string value = argv[++i];
-      if (argument == "-gt")
+      if (argument == "-gt") {
         options.reference = value;
-      else if (argument == "-out")
+      } else if (argument == "-out") {
         options.out_dir = value;
-      else if (!parseMethods(value, options.methods, error))
+      } else if (argument == "-picture_size") {
+        if (!parsePictureSize(value, options.picture_size, error))
+          return false;
+      } else if (!parseMethods(value, options.methods, error)) {
         return false;
+      }
     } else if (argument.size() > 1 && argument[0] == '-') {
       error = "unknown option '" + argument + "' (see -h)";
       return false;
@@ -317,7 +339,7 @@ bool saveRunMesh(const std::string &path, const PeerRun &run, std::string &error
 
 /// Pictures are a bonus: when they cannot be made, say so once and go on.
 void writePictures(const fs::path &dir, const std::vector<Eigen::Vector3d> &points,
-                   const std::vector<Entry> &entries, bool verbose) {
+                   const std::vector<Entry> &entries, int picture_size, bool verbose) {
   const RenderView view = viewFramingPoints(points);
   std::vector<std::string> pictures;
   std::string error;
@@ -326,6 +348,7 @@ void writePictures(const fs::path &dir, const std::vector<Eigen::Vector3d> &poin
       continue;
     RenderOptions options;
     options.caption = methodLabel(entry.run.method);
+    options.width = options.height = picture_size;
     const std::string path = (dir / (methodKey(entry.run.method) + ".png")).string();
     if (!renderMeshPng(entry.run.vertices, entry.run.triangles, view, options, path, error)) {
       std::fflush(stdout);
@@ -454,7 +477,7 @@ int run(int argc, char **argv) {
       !writeMarkdown(md_path, options, points.size(), skipped, entries, baseline_mb, with_reference,
                      reference_triangles.size(), error))
     return fail(kIoFailure, error);
-  writePictures(dir, input_positions, entries, verbose);
+  writePictures(dir, input_positions, entries, options.picture_size, verbose);
   if (verbose) {
     std::printf("Wrote %s and %s\n", md_path.c_str(), csv_path.c_str());
   }
