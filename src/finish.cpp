@@ -31,6 +31,9 @@ EdgeKey edgeKey(VertexIndex a, VertexIndex b) {
   return (static_cast<EdgeKey>(a) << 32) | b;
 }
 
+VertexIndex lowVertex(EdgeKey key) { return static_cast<VertexIndex>(key >> 32); }
+VertexIndex highVertex(EdgeKey key) { return static_cast<VertexIndex>(key & 0xffffffffu); }
+
 struct EdgeUse {
   EdgeKey key;
   std::uint32_t triangle;
@@ -39,14 +42,29 @@ struct EdgeUse {
   }
 };
 
-/// Every (edge, triangle) incidence, sorted by edge then triangle.
+/// Every (edge, triangle) incidence, sorted by edge then triangle: bucketed
+/// by the edge's lower vertex first (linear), so only a vertex's few edges
+/// are sorted, instead of one sort of all of them.
 std::vector<EdgeUse> edgeUses(const std::vector<Triangle> &triangles) {
-  std::vector<EdgeUse> uses;
-  uses.reserve(3 * triangles.size());
-  for (std::uint32_t t = 0; t < triangles.size(); ++t)
+  VertexIndex vertex_count = 0;
+  for (const Triangle &triangle : triangles)
+    for (VertexIndex v : triangle)
+      vertex_count = std::max(vertex_count, v + 1);
+  std::vector<std::uint32_t> offsets(static_cast<std::size_t>(vertex_count) + 1, 0);
+  for (const Triangle &triangle : triangles)
     for (int k = 0; k < 3; ++k)
-      uses.push_back({edgeKey(triangles[t][k], triangles[t][(k + 1) % 3]), t});
-  std::sort(uses.begin(), uses.end());
+      ++offsets[lowVertex(edgeKey(triangle[k], triangle[(k + 1) % 3])) + 1];
+  for (std::size_t v = 0; v < vertex_count; ++v)
+    offsets[v + 1] += offsets[v];
+  std::vector<EdgeUse> uses(3 * triangles.size());
+  for (std::uint32_t t = 0; t < triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const EdgeKey key = edgeKey(triangles[t][k], triangles[t][(k + 1) % 3]);
+      uses[offsets[lowVertex(key)]++] = {key, t};
+    }
+  // offsets[v] now ends vertex v's range, which starts where v - 1's ended.
+  for (std::size_t v = 0, begin = 0; v < vertex_count; begin = offsets[v++])
+    std::sort(uses.begin() + begin, uses.begin() + offsets[v]);
   return uses;
 }
 
@@ -60,9 +78,6 @@ template <typename Visit> void forEachEdge(const std::vector<EdgeUse> &uses, con
     i = j;
   }
 }
-
-VertexIndex lowVertex(EdgeKey key) { return static_cast<VertexIndex>(key >> 32); }
-VertexIndex highVertex(EdgeKey key) { return static_cast<VertexIndex>(key & 0xffffffffu); }
 
 /// Whether triangle t, as stored, runs from a to b.
 bool runsFromTo(const Triangle &t, VertexIndex a, VertexIndex b) {
