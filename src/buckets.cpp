@@ -372,10 +372,14 @@ public:
       }
     }
     surface_.triangles = std::move(nodes[tree_.root()].triangles);
-    // A seam that could not join two fixed fans at a vertex leaves a bow-tie.
-    std::vector<bool> every_vertex(points_.size(), true);
+    // Kept triangles may pinch where their neighbours were cut away, and a
+    // seam may fail to join two fixed fans at a vertex: bow-ties are possible
+    // only at those vertices.
+    std::vector<bool> may_pinch(points_.size(), false);
+    for (std::size_t v = 0; v < points_.size(); ++v)
+      may_pinch[v] = may_pinch_[v] != 0;
     surface_.statistics.bow_tie_triangles_removed =
-        splitBowTies(surface_.triangles, points_.size(), every_vertex);
+        splitBowTies(surface_.triangles, points_.size(), may_pinch);
     surface_.statistics.seams_seconds = secondsSince(stage);
     return std::move(surface_);
   }
@@ -418,6 +422,7 @@ private:
     }
     outcome = meshBucket(task, parameters_);
     leaf.triangles = toGlobal(outcome.triangles, members);
+    markMayPinch(outcome.cut_vertices, members);
   }
 
   /// The zone along node's split plane: the subtree's points within d_max
@@ -479,6 +484,10 @@ private:
             {localIndex(triangle[0]), localIndex(triangle[1]), localIndex(triangle[2])});
       outcome = meshBucket(task, parameters_);
       added = toGlobal(outcome.triangles, members);
+      markMayPinch(outcome.cut_vertices, members);
+      for (std::size_t i = 0; i < members.size(); ++i)
+        if (task.core[i])
+          may_pinch_[members[i]] = 1;
     } else {
       outcome.error = "too few points";
     }
@@ -496,6 +505,13 @@ private:
 
   std::vector<Node> &nodes_() { return tree_.nodes(); }
 
+  /// Units write disjoint points (their core), so bytes, not bits.
+  void markMayPinch(const std::vector<VertexIndex> &local,
+                    const std::vector<VertexIndex> &members) {
+    for (VertexIndex v : local)
+      may_pinch_[members[v]] = 1;
+  }
+
   void addTimings(const BucketOutcome &outcome) {
     surface_.delaunay_seconds += outcome.delaunay_seconds;
     surface_.scaffold_seconds += outcome.scaffold_seconds;
@@ -509,6 +525,7 @@ private:
   double margin_ = 0;
   BucketedSurface surface_;
   std::mutex statistics_mutex_;
+  std::vector<std::uint8_t> may_pinch_ = std::vector<std::uint8_t>(points_.size(), 0);
 };
 
 } // namespace
@@ -537,9 +554,19 @@ BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters) {
     const Clock::time_point greedy_start = Clock::now();
     GreedyMesher mesher(scaffold, task.points, parameters);
     mesher.run();
-    for (const Triangle &triangle : mesher.triangles(false))
-      if (task.core[triangle[0]] && task.core[triangle[1]] && task.core[triangle[2]])
+    for (const Triangle &triangle : mesher.triangles(false)) {
+      if (task.core[triangle[0]] && task.core[triangle[1]] && task.core[triangle[2]]) {
         outcome.triangles.push_back(triangle);
+        continue;
+      }
+      for (VertexIndex v : triangle)
+        if (task.core[v])
+          outcome.cut_vertices.push_back(v);
+    }
+    std::sort(outcome.cut_vertices.begin(), outcome.cut_vertices.end());
+    outcome.cut_vertices.erase(
+        std::unique(outcome.cut_vertices.begin(), outcome.cut_vertices.end()),
+        outcome.cut_vertices.end());
     outcome.greedy_seconds = secondsSince(greedy_start);
   } catch (const ReconstructionError &error) {
     outcome.error = error.what();

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <numeric>
 #include <queue>
 #include <set>
 
@@ -34,48 +35,61 @@ EdgeKey edgeKey(VertexIndex a, VertexIndex b) {
 VertexIndex lowVertex(EdgeKey key) { return static_cast<VertexIndex>(key >> 32); }
 VertexIndex highVertex(EdgeKey key) { return static_cast<VertexIndex>(key & 0xffffffffu); }
 
+/// One (edge, triangle) incidence, filed under the edge's lower vertex.
 struct EdgeUse {
-  EdgeKey key;
+  VertexIndex high; // the edge's other vertex
   std::uint32_t triangle;
   bool operator<(const EdgeUse &other) const {
-    return key < other.key || (key == other.key && triangle < other.triangle);
+    return high < other.high || (high == other.high && triangle < other.triangle);
   }
 };
 
-/// Every (edge, triangle) incidence, sorted by edge then triangle: bucketed
-/// by the edge's lower vertex first (linear), so only a vertex's few edges
-/// are sorted, instead of one sort of all of them.
-std::vector<EdgeUse> edgeUses(const std::vector<Triangle> &triangles) {
+/// Every (edge, triangle) incidence, by lower vertex (CSR), then by upper
+/// vertex and triangle: 8 bytes an incidence, and only each vertex's few
+/// edges are sorted.
+struct EdgeUses {
+  std::vector<std::uint32_t> offsets; // vertex v's uses are [offsets[v], offsets[v + 1])
+  std::vector<EdgeUse> uses;
+};
+
+EdgeUses edgeUses(const std::vector<Triangle> &triangles) {
   VertexIndex vertex_count = 0;
   for (const Triangle &triangle : triangles)
     for (VertexIndex v : triangle)
       vertex_count = std::max(vertex_count, v + 1);
-  std::vector<std::uint32_t> offsets(static_cast<std::size_t>(vertex_count) + 1, 0);
+  EdgeUses result;
+  std::vector<std::uint32_t> &offsets = result.offsets;
+  offsets.assign(static_cast<std::size_t>(vertex_count) + 1, 0);
   for (const Triangle &triangle : triangles)
     for (int k = 0; k < 3; ++k)
       ++offsets[lowVertex(edgeKey(triangle[k], triangle[(k + 1) % 3])) + 1];
   for (std::size_t v = 0; v < vertex_count; ++v)
     offsets[v + 1] += offsets[v];
-  std::vector<EdgeUse> uses(3 * triangles.size());
+  result.uses.resize(3 * triangles.size());
+  std::vector<std::uint32_t> cursor(offsets.begin(), offsets.end() - 1);
   for (std::uint32_t t = 0; t < triangles.size(); ++t)
     for (int k = 0; k < 3; ++k) {
       const EdgeKey key = edgeKey(triangles[t][k], triangles[t][(k + 1) % 3]);
-      uses[offsets[lowVertex(key)]++] = {key, t};
+      result.uses[cursor[lowVertex(key)]++] = {highVertex(key), t};
     }
-  // offsets[v] now ends vertex v's range, which starts where v - 1's ended.
-  for (std::size_t v = 0, begin = 0; v < vertex_count; begin = offsets[v++])
-    std::sort(uses.begin() + begin, uses.begin() + offsets[v]);
-  return uses;
+  for (std::size_t v = 0; v < vertex_count; ++v)
+    std::sort(result.uses.begin() + offsets[v], result.uses.begin() + offsets[v + 1]);
+  return result;
 }
 
-/// Calls visit(key, first_use, count) for each distinct edge.
-template <typename Visit> void forEachEdge(const std::vector<EdgeUse> &uses, const Visit &visit) {
-  for (std::size_t i = 0; i < uses.size();) {
-    std::size_t j = i;
-    while (j < uses.size() && uses[j].key == uses[i].key)
-      ++j;
-    visit(uses[i].key, i, j - i);
-    i = j;
+/// Calls visit(key, first_use, count) for each distinct edge, in key order;
+/// first_use indexes uses.uses.
+template <typename Visit> void forEachEdge(const EdgeUses &uses, const Visit &visit) {
+  const std::size_t vertex_count = uses.offsets.empty() ? 0 : uses.offsets.size() - 1;
+  for (std::size_t low = 0; low < vertex_count; ++low) {
+    const std::size_t end = uses.offsets[low + 1];
+    for (std::size_t i = uses.offsets[low]; i < end;) {
+      std::size_t j = i;
+      while (j < end && uses.uses[j].high == uses.uses[i].high)
+        ++j;
+      visit(edgeKey(static_cast<VertexIndex>(low), uses.uses[i].high), i, j - i);
+      i = j;
+    }
   }
 }
 
@@ -171,7 +185,7 @@ std::vector<Triangle> triangulateLoop(const std::vector<VertexIndex> &loop,
 } // namespace
 
 std::vector<std::vector<VertexIndex>> traceBoundaryLoops(const std::vector<Triangle> &triangles) {
-  const std::vector<EdgeUse> uses = edgeUses(triangles);
+  const EdgeUses uses = edgeUses(triangles);
   // Boundary edges in both directions, sorted: a CSR of boundary neighbours.
   struct HalfEdge {
     VertexIndex from, to;
@@ -245,18 +259,20 @@ std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen:
   });
   if (!any_small_loop)
     return 0;
-  std::vector<EdgeKey> mesh_edges;
-  for (const Triangle &t : triangles)
-    for (int k = 0; k < 3; ++k)
-      mesh_edges.push_back(edgeKey(t[k], t[(k + 1) % 3]));
-  std::sort(mesh_edges.begin(), mesh_edges.end());
-  mesh_edges.erase(std::unique(mesh_edges.begin(), mesh_edges.end()), mesh_edges.end());
-  // Existing triangles matter only where all three corners are on a loop.
+  // Existing edges and triangles matter only where all their corners are
+  // on a loop that may be filled: that keeps these lists short.
   std::vector<bool> on_small_loop(points.size(), false);
   for (const auto &loop : loops)
     if (loop.size() <= static_cast<std::size_t>(max_edges))
       for (VertexIndex v : loop)
         on_small_loop[v] = true;
+  std::vector<EdgeKey> mesh_edges;
+  for (const Triangle &t : triangles)
+    for (int k = 0; k < 3; ++k)
+      if (on_small_loop[t[k]] && on_small_loop[t[(k + 1) % 3]])
+        mesh_edges.push_back(edgeKey(t[k], t[(k + 1) % 3]));
+  std::sort(mesh_edges.begin(), mesh_edges.end());
+  mesh_edges.erase(std::unique(mesh_edges.begin(), mesh_edges.end()), mesh_edges.end());
   std::set<std::array<VertexIndex, 3>> existing;
   for (Triangle t : triangles)
     if (on_small_loop[t[0]] && on_small_loop[t[1]] && on_small_loop[t[2]]) {
@@ -294,30 +310,32 @@ namespace {
 struct ManifoldPair {
   std::uint32_t first, second;
   VertexIndex a, b; // the shared edge
-  double bending;
 };
 
 std::vector<ManifoldPair> manifoldPairs(const std::vector<Triangle> &triangles) {
-  const std::vector<EdgeUse> uses = edgeUses(triangles);
+  const EdgeUses uses = edgeUses(triangles);
+  std::size_t count_of_pairs = 0;
+  forEachEdge(uses, [&](EdgeKey, std::size_t, std::size_t count) { count_of_pairs += count == 2; });
   std::vector<ManifoldPair> pairs;
+  pairs.reserve(count_of_pairs);
   forEachEdge(uses, [&](EdgeKey key, std::size_t first, std::size_t count) {
     if (count == 2)
-      pairs.push_back(
-          {uses[first].triangle, uses[first + 1].triangle, lowVertex(key), highVertex(key), 0});
+      pairs.push_back({uses.uses[first].triangle, uses.uses[first + 1].triangle, lowVertex(key),
+                       highVertex(key)});
   });
   return pairs;
 }
 
-void computeBending(ManifoldPair &pair, const std::vector<Triangle> &triangles,
-                    const std::vector<Eigen::Vector3d> &points) {
+double bendingAt(const ManifoldPair &pair, const std::vector<Triangle> &triangles,
+                 const std::vector<Eigen::Vector3d> &points) {
   auto apex = [&](std::uint32_t t) {
     for (VertexIndex v : triangles[t])
       if (v != pair.a && v != pair.b)
         return v;
     return pair.a;
   };
-  pair.bending = bendingAngle(points[pair.a], points[pair.b], points[apex(pair.first)],
-                              points[apex(pair.second)]);
+  return bendingAngle(points[pair.a], points[pair.b], points[apex(pair.first)],
+                      points[apex(pair.second)]);
 }
 
 /// Whether t and u run their shared edge in opposite directions.
@@ -328,15 +346,32 @@ bool consistentlyOriented(const Triangle &t, const Triangle &u) {
   return false;
 }
 
-/// The triangles at each vertex.
-std::vector<std::vector<std::uint32_t>> vertexFans(const std::vector<Triangle> &triangles,
-                                                   std::size_t vertex_count) {
-  std::vector<std::vector<std::uint32_t>> at(vertex_count);
-  for (std::uint32_t t = 0; t < triangles.size(); ++t)
-    for (VertexIndex v : triangles[t])
-      at[v].push_back(t);
-  return at;
-}
+/// The triangles at each marked vertex: one scan of the mesh, and memory
+/// for the marked vertices only (a few, or a seam's, of a large mesh).
+class MarkedIncidence {
+public:
+  MarkedIncidence(const std::vector<Triangle> &triangles, const std::vector<bool> &marked) {
+    for (VertexIndex v = 0; v < marked.size(); ++v)
+      if (marked[v])
+        vertices_.push_back(v);
+    at_.resize(vertices_.size());
+    for (std::uint32_t t = 0; t < triangles.size(); ++t)
+      for (VertexIndex v : triangles[t])
+        if (v < marked.size() && marked[v])
+          at_[slot(v)].push_back(t);
+  }
+  const std::vector<VertexIndex> &vertices() const { return vertices_; }
+  const std::vector<std::uint32_t> &atSlot(std::size_t slot) const { return at_[slot]; }
+  const std::vector<std::uint32_t> &at(VertexIndex v) const { return at_[slot(v)]; }
+
+private:
+  std::size_t slot(VertexIndex v) const {
+    return static_cast<std::size_t>(std::lower_bound(vertices_.begin(), vertices_.end(), v) -
+                                    vertices_.begin());
+  }
+  std::vector<VertexIndex> vertices_; // ascending
+  std::vector<std::vector<std::uint32_t>> at_;
+};
 
 /// The triangles at v (given in `around`) grouped into fans joined by edges at v.
 std::vector<std::vector<std::uint32_t>> fansAt(VertexIndex v,
@@ -411,14 +446,16 @@ void dropTriangles(std::vector<Triangle> &triangles, const std::vector<bool> &dr
 std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_count,
                          std::vector<bool> &touched) {
   const std::size_t before = triangles.size();
+  touched.resize(vertex_count, false);
   for (bool changed = true; changed;) {
     changed = false;
-    const auto at = vertexFans(triangles, vertex_count);
+    const MarkedIncidence incidence(triangles, touched);
     std::vector<bool> drop(triangles.size(), false);
-    for (VertexIndex v = 0; v < vertex_count; ++v) {
-      if (!touched[v] || at[v].size() < 2)
+    for (std::size_t slot = 0; slot < incidence.vertices().size(); ++slot) {
+      const VertexIndex v = incidence.vertices()[slot];
+      if (incidence.atSlot(slot).size() < 2)
         continue;
-      const auto fans = fansAt(v, at[v], triangles);
+      const auto fans = fansAt(v, incidence.atSlot(slot), triangles);
       if (fans.size() < 2)
         continue;
       std::size_t keep = 0;
@@ -441,7 +478,7 @@ std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
                                             std::vector<std::uint32_t> &triangle_component,
                                             std::vector<bool> &component_orientable) {
   const std::uint32_t unvisited = std::numeric_limits<std::uint32_t>::max();
-  std::vector<ManifoldPair> pairs = manifoldPairs(triangles);
+  const std::vector<ManifoldPair> pairs = manifoldPairs(triangles);
   std::vector<std::uint32_t> offsets(triangles.size() + 1, 0);
   for (const ManifoldPair &pair : pairs) {
     ++offsets[pair.first + 1];
@@ -495,44 +532,70 @@ std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
     if (!consistentlyOriented(triangles[pair.first], triangles[pair.second]))
       component_orientable[triangle_component[pair.first]] = false;
 
-  // Where none exists, orientation spreads again across the flattest edges
-  // first (a maximum spanning tree on flatness), so that the edges left
-  // inconsistent are the component's most bent ones, i.e. where the twist is.
-  using Step = std::pair<double, std::uint32_t>; // bending, pair index
-  std::priority_queue<Step, std::vector<Step>, std::greater<Step>> frontier;
-  for (std::uint32_t component = 0; component < members.size(); ++component) {
-    if (component_orientable[component])
-      continue;
-    for (std::uint32_t t : members[component])
-      for (std::uint32_t i = offsets[t]; i < offsets[t + 1]; ++i)
-        computeBending(pairs[incident[i]], triangles, points);
-    const std::uint32_t seed = members[component].front();
-    for (std::uint32_t t : members[component])
-      triangle_component[t] = unvisited;
-    members[component] = {seed};
-    triangle_component[seed] = component;
-    auto spreadFrom = [&](std::uint32_t t) {
-      for (std::uint32_t i = offsets[t]; i < offsets[t + 1]; ++i)
-        frontier.push({pairs[incident[i]].bending, incident[i]});
-    };
-    spreadFrom(seed);
-    while (!frontier.empty()) {
-      const ManifoldPair &pair = pairs[frontier.top().second];
-      frontier.pop();
-      if (triangle_component[pair.first] != unvisited &&
-          triangle_component[pair.second] != unvisited)
-        continue;
-      const std::uint32_t next = orientAcross(pair, component);
-      members[component].push_back(next);
-      spreadFrom(next);
+  // Where none exists, orientation follows a maximum spanning forest on
+  // flatness (pairs joined flattest first, Kruskal's order), so that the
+  // edges left inconsistent are the component's most bent ones, i.e. where
+  // the twist is. A union-find keeps each triangle's flip relative to its
+  // root; each component's first triangle keeps its orientation.
+  std::vector<double> bending; // per pair, where a component needs it
+  std::vector<std::pair<double, std::uint32_t>> flattest_first; // bending, pair
+  for (std::uint32_t p = 0; p < pairs.size(); ++p)
+    if (!component_orientable[triangle_component[pairs[p].first]]) {
+      bending.resize(pairs.size(), 0.0);
+      bending[p] = bendingAt(pairs[p], triangles, points);
+      flattest_first.emplace_back(bending[p], p);
     }
+  if (!flattest_first.empty()) {
+    std::sort(flattest_first.begin(), flattest_first.end());
+    std::vector<std::uint32_t> parent(triangles.size());
+    std::vector<std::uint8_t> flip_to_parent(triangles.size(), 0);
+    std::iota(parent.begin(), parent.end(), 0u);
+    // The root of t, and whether t is flipped relative to it.
+    auto find = [&](std::uint32_t t) {
+      std::uint8_t flip = 0;
+      std::uint32_t root = t;
+      while (parent[root] != root) {
+        flip ^= flip_to_parent[root];
+        root = parent[root];
+      }
+      // Path compression: point every triangle on the path at the root.
+      for (std::uint8_t rest = flip; parent[t] != t;) {
+        const std::uint32_t next = parent[t];
+        const std::uint8_t step = flip_to_parent[t];
+        parent[t] = root;
+        flip_to_parent[t] = rest;
+        rest ^= step;
+        t = next;
+      }
+      return std::make_pair(root, flip);
+    };
+    for (const auto &[flatness, p] : flattest_first) {
+      const ManifoldPair &pair = pairs[p];
+      // Flipping exactly one of the two changes whether they agree.
+      const std::uint8_t must_differ =
+          consistentlyOriented(triangles[pair.first], triangles[pair.second]) ? 0 : 1;
+      const auto [first_root, first_flip] = find(pair.first);
+      const auto [second_root, second_flip] = find(pair.second);
+      if (first_root == second_root)
+        continue; // a cycle: consistent or not, the tree decides
+      // The smaller index becomes the root, so the component's first triangle ends as root.
+      const std::uint32_t root = std::min(first_root, second_root);
+      const std::uint32_t child = std::max(first_root, second_root);
+      parent[child] = root;
+      flip_to_parent[child] = first_flip ^ second_flip ^ must_differ;
+    }
+    for (std::uint32_t t = 0; t < triangles.size(); ++t)
+      if (!component_orientable[triangle_component[t]] && find(t).second)
+        std::swap(triangles[t][1], triangles[t][2]);
   }
   std::vector<std::uint32_t> sharply_bent_conflicts;
-  for (const ManifoldPair &pair : pairs)
+  for (std::uint32_t p = 0; p < pairs.size(); ++p) {
+    const ManifoldPair &pair = pairs[p];
     if (!component_orientable[triangle_component[pair.first]] &&
         !consistentlyOriented(triangles[pair.first], triangles[pair.second]) &&
-        pair.bending > max_untwist_bending)
+        bending[p] > max_untwist_bending)
       sharply_bent_conflicts.push_back(pair.first);
+  }
   for (std::uint32_t component = 0; component < members.size(); ++component) {
     if (!component_orientable[component])
       continue;
@@ -556,7 +619,11 @@ std::size_t removeTwistedFans(std::vector<Triangle> &triangles,
   const std::size_t before = triangles.size();
   // At each twisted spot the corner whose fan is most crumpled (typically a
   // stray point) loses its fan.
-  const auto at = vertexFans(triangles, points.size());
+  std::vector<bool> corners(points.size(), false);
+  for (std::uint32_t t : twisted)
+    for (VertexIndex v : triangles[t])
+      corners[v] = true;
+  const MarkedIncidence incidence(triangles, corners);
   std::vector<bool> drop(triangles.size(), false);
   for (std::uint32_t t : twisted) {
     VertexIndex worst = triangles[t][0];
@@ -564,7 +631,7 @@ std::size_t removeTwistedFans(std::vector<Triangle> &triangles,
     for (VertexIndex v : triangles[t]) {
       if (anchored_vertices && (*anchored_vertices)[v])
         continue;
-      const double spread = fanSpread(at[v], triangles, points);
+      const double spread = fanSpread(incidence.at(v), triangles, points);
       if (spread > worst_spread) {
         worst_spread = spread;
         worst = v;
@@ -572,7 +639,7 @@ std::size_t removeTwistedFans(std::vector<Triangle> &triangles,
     }
     if (worst_spread < 0) // every corner anchored: leave the twist
       continue;
-    for (std::uint32_t u : at[worst])
+    for (std::uint32_t u : incidence.at(worst))
       drop[u] = true;
   }
   dropTriangles(triangles, drop, touched);

@@ -116,14 +116,14 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, Result &r
     const float *p = recordAt(view.xyz, view.stride, record);
     return std::array<float, 3>{p[0], p[1], p[2]};
   };
-  std::vector<std::size_t> order(records.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+  std::vector<VertexIndex> order(records.size());
+  std::iota(order.begin(), order.end(), VertexIndex{0});
+  std::sort(order.begin(), order.end(), [&](VertexIndex a, VertexIndex b) {
     const auto pa = coordinates(records[a]), pb = coordinates(records[b]);
     return pa < pb || (pa == pb && a < b);
   });
   std::vector<bool> keep(records.size(), true);
-  std::vector<std::size_t> representative(records.size());
+  std::vector<VertexIndex> representative(records.size());
   for (std::size_t i = 0; i < order.size(); ++i) {
     representative[order[i]] = order[i];
     if (i > 0 && coordinates(records[order[i]]) == coordinates(records[order[i - 1]])) {

@@ -44,6 +44,9 @@ struct BucketTask {
 
 struct BucketOutcome {
   std::vector<Triangle> triangles; // new triangles on core points, local indices
+  /// Core points that lost a triangle because another of its corners was
+  /// not core: where the kept triangles may pinch, ascending.
+  std::vector<VertexIndex> cut_vertices;
   double d_med = 0;
   double delaunay_seconds = 0, scaffold_seconds = 0, greedy_seconds = 0;
   /// Not empty when the unit could not be meshed (e.g. collinear points).
