@@ -25,15 +25,19 @@ double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// The margin reaches this many d_med beyond the seam width, so that the
-// triangles a seam keeps fixed were decided with their neighbourhood.
+// The margin is (rho + this) estimated d_med wide: beyond the seam width,
+// so that the triangles a seam keeps fixed were decided with points around.
 constexpr double margin_context_in_d_med = 6;
 
 // Nearest-neighbour samples per bucket for the spacing estimate.
 constexpr std::size_t spacing_samples_per_bucket = 32;
 
-// d_med (median circumradius of Gabriel triangles) over the median
-// nearest-neighbour distance; measured on the bunny and its samplings.
+// Estimated d_med (median circumradius of Gabriel triangles) per median
+// nearest-neighbour distance. The true ratio is 0.88 on the bunny's vertices
+// and 1.6 on uniform random samplings of it; 0.75, below both, makes the
+// margin 8.25 spacings at rho 5, i.e. 5.2 to 9.4 d_med on these two, above the
+// seam width d_max. With it the seams reproduce 99.999 % of the one-piece
+// mesh on 300k points.
 constexpr double d_med_per_spacing = 0.75;
 
 struct Box {
