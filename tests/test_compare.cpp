@@ -2,17 +2,15 @@
 // Tests of the pcl_ms_compare (suite CompareApp) and pcl_ms_evaluate (suite
 // EvaluateApp) programs, run as a user would on the bundled data. Every file
 // they write goes to a fresh temporary directory.
+#include "program_test.h"
+
 #include <pcl_ms/io.h>
 
 #include <boost/property_tree/json_parser.hpp>
 #include <boost/property_tree/ptree.hpp>
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -25,30 +23,12 @@
 
 namespace {
 
-namespace fs = std::filesystem;
+using namespace pcl_ms_test;
 
 const std::string kDataDir = PCL_MS_DATA_DIR;
 const std::string kCompare = std::string(PCL_MS_BINARY_DIR) + "/pcl_ms_compare";
 const std::string kEvaluate = std::string(PCL_MS_BINARY_DIR) + "/pcl_ms_evaluate";
 const std::vector<std::string> kMethods = {"pcl_ms", "gp3", "poisson", "afsr"};
-
-std::string readFile(const std::string &path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
-
-void writeFile(const std::string &path, const std::string &bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out << bytes;
-}
-
-bool contains(const std::string &text, const std::string &part) {
-  return text.find(part) != std::string::npos;
-}
-
-std::string quoted(const std::string &path) { return "'" + path + "'"; }
 
 /// One CSV record per line (the tools never put line breaks in fields);
 /// quoted fields may hold commas and doubled quotes.
@@ -98,35 +78,16 @@ double number(const std::map<std::string, std::string> &row, const std::string &
   return std::strtod(found->second.c_str(), nullptr);
 }
 
-class ProgramTest : public ::testing::Test {
+class ProgramTest : public TempDirTest {
 protected:
   void SetUp() override {
-    static std::atomic<int> counter{0};
-    const ::testing::TestInfo *info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("pcl_ms_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" +
-            std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(dir_);
-    ASSERT_TRUE(fs::create_directories(dir_));
+    TempDirTest::SetUp();
     ASSERT_TRUE(fs::exists(kCompare)) << kCompare << " was not built";
     ASSERT_TRUE(fs::exists(kEvaluate)) << kEvaluate << " was not built";
   }
-  void TearDown() override {
-    std::error_code ignored;
-    fs::remove_all(dir_, ignored);
-  }
 
-  std::string path(const std::string &name) const { return (dir_ / name).string(); }
-
-  /// Runs `program` with `arguments`; returns its exit code and keeps what it
-  /// printed in stdout_ and stderr_.
   int run(const std::string &program, const std::string &arguments) {
-    const std::string command = quoted(program) + " " + arguments + " > " +
-                                quoted(path("stdout.txt")) + " 2> " + quoted(path("stderr.txt"));
-    const int status = std::system(command.c_str());
-    stdout_ = readFile(path("stdout.txt"));
-    stderr_ = readFile(path("stderr.txt"));
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    return runProgram(program, arguments);
   }
 
   /// Failure means the given exit code and exactly one line "error: ..." on stderr.
@@ -155,9 +116,6 @@ protected:
     for (const std::string &picture : pictures)
       EXPECT_EQ(readFile(picture).substr(0, 8), "\x89PNG\r\n\x1a\n") << picture;
   }
-
-  fs::path dir_;
-  std::string stdout_, stderr_;
 };
 
 class CompareApp : public ProgramTest {};

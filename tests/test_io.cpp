@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Tests of pcl_ms/io.h (suites Io*) and of the pcl_ms_reconstruct program
 // (suite App). Every file they write goes to a fresh temporary directory.
+#include "program_test.h"
+
 #include <pcl_ms/io.h>
 
 #include <gtest/gtest.h>
@@ -9,61 +11,20 @@
 #include <pcl/io/ply_io.h>
 #include <pcl/point_types.h>
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
 #include <cstdint>
-#include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
 namespace {
 
-namespace fs = std::filesystem;
+using namespace pcl_ms_test;
 
 const std::string kDataDir = PCL_MS_DATA_DIR;
 const std::string kApp = std::string(PCL_MS_BINARY_DIR) + "/pcl_ms_reconstruct";
-
-/// Each test gets its own directory under the system temp dir, removed afterwards.
-class TempDirTest : public ::testing::Test {
-protected:
-  void SetUp() override {
-    static std::atomic<int> counter{0};
-    const ::testing::TestInfo *info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("pcl_ms_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" +
-            std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(dir_);
-    ASSERT_TRUE(fs::create_directories(dir_));
-  }
-  void TearDown() override {
-    std::error_code ignored;
-    fs::remove_all(dir_, ignored);
-  }
-
-  std::string path(const std::string &name) const { return (dir_ / name).string(); }
-
-  fs::path dir_;
-};
-
-void writeFile(const std::string &path, const std::string &bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out << bytes;
-}
-
-std::string readFile(const std::string &path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
 
 /// Keeps the first `size` bytes of a file, as an interrupted copy would.
 void cutFile(const std::string &path, std::size_t size) {
@@ -162,10 +123,6 @@ std::string expectMeshFailure(const std::string &file) {
   EXPECT_TRUE(vertices.empty());
   EXPECT_TRUE(triangles.empty());
   return error;
-}
-
-bool contains(const std::string &text, const std::string &part) {
-  return text.find(part) != std::string::npos;
 }
 
 // ---------------------------------------------------------------------------
@@ -754,14 +711,7 @@ class App : public TempDirTest {
 protected:
   /// Runs pcl_ms_reconstruct with `arguments`; returns its exit code and
   /// keeps what it printed in stdout_ and stderr_.
-  int run(const std::string &arguments) {
-    const std::string command = "'" + kApp + "' " + arguments + " > '" + path("stdout.txt") +
-                                "' 2> '" + path("stderr.txt") + "'";
-    const int status = std::system(command.c_str());
-    stdout_ = readFile(path("stdout.txt"));
-    stderr_ = readFile(path("stderr.txt"));
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  }
+  int run(const std::string &arguments) { return runProgram(kApp, arguments); }
 
   /// Failure means a non-zero exit and exactly one line "error: ..." on stderr.
   void expectFailure(const std::string &arguments, const std::string &reason_part) {
@@ -776,8 +726,6 @@ protected:
     TempDirTest::SetUp();
     ASSERT_TRUE(fs::exists(kApp)) << kApp << " was not built";
   }
-
-  std::string stdout_, stderr_;
 };
 
 TEST_F(App, ReconstructsBun0IntoEveryFormat) {
