@@ -491,9 +491,5 @@ int run(int argc, char **argv) {
 } // namespace
 
 int main(int argc, char **argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception &exception) {
-    return fail(kReconstructionFailure, std::string("unexpected failure: ") + exception.what());
-  }
+  return pcl_ms_tools::runGuarded(run, argc, argv, pcl_ms_tools::kReconstructionFailure);
 }

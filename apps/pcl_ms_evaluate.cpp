@@ -11,7 +11,6 @@
 #include <pcl_ms/mesh_quality.h>
 
 #include <cstdio>
-#include <exception>
 #include <string>
 #include <vector>
 
@@ -174,9 +173,5 @@ int run(int argc, char **argv) {
 } // namespace
 
 int main(int argc, char **argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception &exception) {
-    return fail(kIoFailure, std::string("unexpected failure: ") + exception.what());
-  }
+  return pcl_ms_tools::runGuarded(run, argc, argv, pcl_ms_tools::kIoFailure);
 }

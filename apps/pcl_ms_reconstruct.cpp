@@ -3,6 +3,8 @@
 // pcl::MedialScaffoldReconstruction and saves the mesh, in the manner of
 // PCL's own command-line tools. On any failure it prints exactly one line,
 // "error: <reason>", on stderr and exits non-zero, so scripts can rely on it.
+#include "tool_support.h"
+
 #include <pcl_ms/buckets.h>
 #include <pcl_ms/io.h>
 #include <pcl_ms/medial_scaffold_reconstruction.h>
@@ -16,7 +18,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
 #include <string>
 #include <utility>
@@ -29,8 +30,12 @@ namespace {
 using pcl::console::print_highlight;
 using pcl::console::print_info;
 using pcl::console::print_value;
-
-enum ExitCode { kSuccess = 0, kBadArguments = 1, kIoFailure = 2, kReconstructionFailure = 3 };
+using pcl_ms_tools::fail;
+using pcl_ms_tools::kBadArguments;
+using pcl_ms_tools::kIoFailure;
+using pcl_ms_tools::kReconstructionFailure;
+using pcl_ms_tools::kSuccess;
+using pcl_ms_tools::SilencePclMessages;
 
 struct Options {
   std::string input, output;
@@ -136,21 +141,6 @@ bool parseArguments(int argc, char **argv, Options &options, std::string &error)
   options.output = positional[1];
   return true;
 }
-
-/// PCL's readers, writers and the reconstruction class print their own
-/// diagnostics on stderr; we report the reason ourselves, in one line.
-class SilencePclMessages {
-public:
-  SilencePclMessages() : previous_(pcl::console::getVerbosityLevel()) {
-    pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
-  }
-  ~SilencePclMessages() { pcl::console::setVerbosityLevel(previous_); }
-  SilencePclMessages(const SilencePclMessages &) = delete;
-  SilencePclMessages &operator=(const SilencePclMessages &) = delete;
-
-private:
-  pcl::console::VERBOSITY_LEVEL previous_;
-};
 
 /// Loads or saves with PCL's own console messages silenced (our one-line
 /// error says it all), timing the step and announcing it in PCL tool style.
@@ -280,12 +270,6 @@ private:
   bool first_ = true;
 };
 
-int fail(ExitCode code, const std::string &reason) {
-  std::fflush(stdout);
-  std::fprintf(stderr, "error: %s\n", reason.c_str());
-  return code;
-}
-
 int run(int argc, char **argv) {
   Options options;
   std::string error;
@@ -391,9 +375,5 @@ int run(int argc, char **argv) {
 } // namespace
 
 int main(int argc, char **argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception &exception) {
-    return fail(kReconstructionFailure, std::string("unexpected failure: ") + exception.what());
-  }
+  return pcl_ms_tools::runGuarded(run, argc, argv, pcl_ms_tools::kReconstructionFailure);
 }

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <exception>
 
 namespace pcl_ms_tools {
 
@@ -12,6 +13,14 @@ int fail(int code, const std::string &reason) {
   std::fflush(stdout);
   std::fprintf(stderr, "error: %s\n", reason.c_str());
   return code;
+}
+
+int runGuarded(int (*run)(int, char **), int argc, char **argv, int failure_code) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception &exception) {
+    return fail(failure_code, std::string("unexpected failure: ") + exception.what());
+  }
 }
 
 std::size_t finitePoints(const pcl::PCLPointCloud2 &cloud, pcl::PointCloud<pcl::PointXYZ> &points) {

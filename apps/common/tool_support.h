@@ -21,6 +21,10 @@ enum ExitCode { kSuccess = 0, kBadArguments = 1, kIoFailure = 2, kReconstruction
 /// Prints "error: <reason>" as one line on stderr and returns `code`.
 int fail(int code, const std::string &reason);
 
+/// A program's main: runs `run`; an exception that escapes it becomes one
+/// error line and `failure_code`, never an abort.
+int runGuarded(int (*run)(int, char **), int argc, char **argv, int failure_code);
+
 /// PCL's readers and algorithms explain failures on the console themselves;
 /// the tools report one line of their own instead.
 class SilencePclMessages {
