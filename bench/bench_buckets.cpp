@@ -9,6 +9,7 @@
 #include "child_process.h"
 #include "peers.h"
 #include "surface_sampling.h"
+#include "tool_support.h"
 
 #include <pcl_ms/io.h>
 #include <pcl_ms/mesh_quality.h>
@@ -57,8 +58,6 @@ std::string serialize(double seconds, double peak_mb, const pcl_ms::MeshTopology
 
 Outcome run(const Configuration &configuration, const pcl::PointCloud<pcl::PointXYZ> &cloud) {
   const pcl_ms_tools::ChildOutcome child = pcl_ms_tools::runInChild([&] {
-    std::vector<Eigen::Vector3d> vertices;
-    vertices.reserve(cloud.size());
     std::vector<pcl_ms::Triangle> triangles;
     double seconds = 0;
     std::size_t buckets = 0;
@@ -84,9 +83,8 @@ Outcome run(const Configuration &configuration, const pcl::PointCloud<pcl::Point
     }
     // The peak is read before the mesh is analysed, which needs memory too.
     const double peak_mb = pcl_ms_tools::peakResidentMb();
-    for (const pcl::PointXYZ &point : cloud)
-      vertices.emplace_back(point.x, point.y, point.z);
-    return serialize(seconds, peak_mb, pcl_ms::analyzeMesh(vertices, triangles), buckets);
+    return serialize(seconds, peak_mb,
+                     pcl_ms::analyzeMesh(pcl_ms_tools::positions(cloud), triangles), buckets);
   });
   Outcome outcome;
   outcome.ok = child.ok;

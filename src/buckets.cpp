@@ -102,9 +102,8 @@ public:
     return leaf_of_[v] >= node.first_leaf && leaf_of_[v] < node.end_leaf;
   }
 
-  /// Points inside `box` that also pass `accept`, ascending.
-  template <typename Accept>
-  std::vector<VertexIndex> gather(const Box &box, const Accept &accept) const {
+  /// Points inside `box`, ascending.
+  std::vector<VertexIndex> gather(const Box &box) const {
     std::vector<VertexIndex> found;
     std::vector<int> stack{root_};
     while (!stack.empty()) {
@@ -114,7 +113,7 @@ public:
         continue;
       if (node.axis < 0) {
         for (VertexIndex v : node.points)
-          if (box.contains(points_[v]) && accept(v))
+          if (box.contains(points_[v]))
             found.push_back(v);
       } else {
         for (int child : node.children)
@@ -324,15 +323,18 @@ public:
                                                       : tbb::task_arena::automatic);
     Clock::time_point stage = Clock::now();
     std::vector<BucketOutcome> leaf_outcomes(leaves.size());
+    std::vector<std::size_t> margin_points(leaves.size(), 0);
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size(), 1),
                         [&](const tbb::blocked_range<std::size_t> &range) {
                           for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                            meshLeaf(nodes[leaves[i]], leaf_outcomes[i]);
+                            margin_points[i] = meshLeaf(nodes[leaves[i]], leaf_outcomes[i]);
                             progress.unitDone();
                           }
                         });
     });
+    for (std::size_t count : margin_points)
+      surface_.statistics.margin_points += count;
     std::vector<double> bucket_d_meds;
     for (const BucketOutcome &outcome : leaf_outcomes) {
       addTimings(outcome);
@@ -412,21 +414,18 @@ private:
   }
 
   /// A bucket: its points plus those within the margin around its region.
-  void meshLeaf(Node &leaf, BucketOutcome &outcome) {
+  /// Returns how many margin points it meshed.
+  std::size_t meshLeaf(Node &leaf, BucketOutcome &outcome) {
     const std::uint32_t leaf_id = leaf.first_leaf;
-    const std::vector<VertexIndex> members =
-        tree_.gather(leaf.region.expanded(margin_), [](VertexIndex) { return true; });
+    const std::vector<VertexIndex> members = tree_.gather(leaf.region.expanded(margin_));
     BucketTask task = makeTask(members);
     task.core.resize(members.size());
     for (std::size_t i = 0; i < members.size(); ++i)
       task.core[i] = tree_.leafOf(members[i]) == leaf_id;
-    {
-      std::lock_guard<std::mutex> lock(statistics_mutex_);
-      surface_.statistics.margin_points += members.size() - leaf.points.size();
-    }
     outcome = meshBucket(task, parameters_);
     leaf.triangles = toGlobal(outcome.triangles, members);
     markMayPinch(outcome.cut_vertices, members);
+    return members.size() - leaf.points.size();
   }
 
   /// The zone along node's split plane: the subtree's points within d_max
@@ -439,7 +438,7 @@ private:
     Box slab = node.region.expanded(margin_);
     slab.low[node.axis] = std::max(slab.low[node.axis], node.split - half_width);
     slab.high[node.axis] = std::min(slab.high[node.axis], node.split + half_width);
-    const std::vector<VertexIndex> zone = tree_.gather(slab, [](VertexIndex) { return true; });
+    const std::vector<VertexIndex> zone = tree_.gather(slab);
     auto inZone = [&](VertexIndex v) { return std::binary_search(zone.begin(), zone.end(), v); };
 
     std::vector<Triangle> subtree_triangles;
@@ -528,7 +527,6 @@ private:
   BucketTree tree_;
   double margin_ = 0;
   BucketedSurface surface_;
-  std::mutex statistics_mutex_;
   std::vector<std::uint8_t> may_pinch_ = std::vector<std::uint8_t>(points_.size(), 0);
 };
 
