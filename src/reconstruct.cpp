@@ -75,7 +75,8 @@ struct PreparedPoints {
   std::vector<Eigen::Vector3f> normals;
   std::vector<VertexIndex> user_index;
   /// For each user record, its distinct point (duplicates share one), or
-  /// not_prepared for records left out (NaN/Inf, not in the indices).
+  /// not_prepared for records left out (NaN/Inf, not in the indices). Only
+  /// built when asked for: initial triangles need it.
   std::vector<VertexIndex> prepared_of_record;
 };
 
@@ -85,7 +86,8 @@ const float *recordAt(const float *base, std::size_t stride, std::size_t record)
   return reinterpret_cast<const float *>(reinterpret_cast<const char *>(base) + record * stride);
 }
 
-PreparedPoints preparePoints(const PointView &view, bool with_normals, Result &result) {
+PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_records,
+                             Result &result) {
   const std::size_t count = view.indices ? view.indices->size() : view.size;
   result.input_points = count;
   if (count > 0 && !view.xyz)
@@ -123,18 +125,13 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, Result &r
     return pa < pb || (pa == pb && a < b);
   });
   std::vector<bool> keep(records.size(), true);
-  std::vector<VertexIndex> representative(records.size());
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    representative[order[i]] = order[i];
-    if (i > 0 && coordinates(records[order[i]]) == coordinates(records[order[i - 1]])) {
+  for (std::size_t i = 1; i < order.size(); ++i)
+    if (coordinates(records[order[i]]) == coordinates(records[order[i - 1]]))
       keep[order[i]] = false;
-      representative[order[i]] = representative[order[i - 1]];
-    }
-  }
 
   PreparedPoints prepared;
-  prepared.prepared_of_record.assign(view.size, not_prepared);
-  std::vector<VertexIndex> prepared_of_kept(records.size(), not_prepared);
+  if (map_records)
+    prepared.prepared_of_record.assign(view.size, not_prepared);
   Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d high = -low;
   for (std::size_t i = 0; i < records.size(); ++i) {
@@ -146,7 +143,8 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, Result &r
     const Eigen::Vector3d position(p[0], p[1], p[2]);
     low = low.cwiseMin(position);
     high = high.cwiseMax(position);
-    prepared_of_kept[i] = static_cast<VertexIndex>(prepared.positions.size());
+    if (map_records)
+      prepared.prepared_of_record[records[i]] = static_cast<VertexIndex>(prepared.positions.size());
     prepared.positions.push_back(position);
     prepared.user_index.push_back(records[i]);
     if (with_normals) {
@@ -159,8 +157,12 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, Result &r
                                      : Eigen::Vector3f::Zero());
     }
   }
-  for (std::size_t i = 0; i < records.size(); ++i)
-    prepared.prepared_of_record[records[i]] = prepared_of_kept[representative[i]];
+  // A duplicate follows its kept copy in `order` (ties sort by position).
+  if (map_records)
+    for (std::size_t i = 1; i < order.size(); ++i)
+      if (!keep[order[i]])
+        prepared.prepared_of_record[records[order[i]]] =
+            prepared.prepared_of_record[records[order[i - 1]]];
   result.used_points = prepared.positions.size();
   if (prepared.positions.size() < 3) {
     std::ostringstream reason;
@@ -235,7 +237,8 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
 
   Result result;
   Clock::time_point stage = Clock::now();
-  const PreparedPoints prepared = preparePoints(points, parameters.use_normals, result);
+  const PreparedPoints prepared =
+      preparePoints(points, parameters.use_normals, !initial_triangles.empty(), result);
   result.timings.prepare = secondsSince(stage);
   result.peak_memory.prepare = peakResidentBytes();
 
