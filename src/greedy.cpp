@@ -162,7 +162,10 @@ private:
     const Candidate &candidate = candidates_[t];
     for (int k = 0; k < 3; ++k) {
       const EdgeIndex e = candidate.edges[k];
-      for (const CandidateIndex *s = scaffold_.edgeBegin(e); s != scaffold_.edgeEnd(e); ++s) {
+      // Type III candidates all wait for Q2 during pass 1.
+      const CandidateIndex *end =
+          queue2_built_ ? scaffold_.edgeEnd(e) : scaffold_.edgeAmbiguousBegin(e);
+      for (const CandidateIndex *s = scaffold_.edgeBegin(e); s != end; ++s) {
         // Dropped candidates never return; waiting Q2 members get their
         // context recomputed when Q2 is built.
         if (*s == t || states_[*s].state == State::dropped || isWaitingForQueue2(*s))
@@ -235,6 +238,13 @@ private:
   void buildQueue2(PassStatistics &statistics) {
     queue2_built_ = true;
     for (CandidateIndex t = 0; t < candidates_.size(); ++t) {
+      if (states_[t].state == State::accepted &&
+          candidates_[t].type == CandidateType::ambiguous) {
+        // A fixed type III triangle: pass 1 did not update its context.
+        states_[t].context = contextFromScratch(t);
+        states_[t].cost = static_cast<float>(freshCost(t));
+        continue;
+      }
       if (states_[t].state != State::queue2)
         continue;
       if (touchesClosedVertex(t)) {
@@ -356,7 +366,10 @@ private:
     for (EdgeIndex e : candidates_[t].edges) {
       if (mesh_.edgeTriangleCount(e) != 1)
         continue;
-      for (const CandidateIndex *s = scaffold_.edgeBegin(e); s != scaffold_.edgeEnd(e); ++s) {
+      // Type III candidates are never in Q1.
+      const CandidateIndex *end =
+          queue == State::queue1 ? scaffold_.edgeAmbiguousBegin(e) : scaffold_.edgeEnd(e);
+      for (const CandidateIndex *s = scaffold_.edgeBegin(e); s != end; ++s) {
         if (*s == t || states_[*s].state != queue ||
             states_[*s].ranking_delays >= parameters_.max_delays)
           continue;
@@ -468,9 +481,16 @@ private:
     return a;
   }
 
-  double angleAt(VertexIndex apex, VertexIndex a, VertexIndex c) const {
-    const Eigen::Vector3d u = points_[a] - points_[apex], w = points_[c] - points_[apex];
-    return std::atan2(u.cross(w).norm(), u.dot(w));
+  /// Whether the angles at b and d opposite edge ac sum to more than pi
+  /// (plus the tolerance): the sine of the sum is negative then. Sines and
+  /// cosines come from cross and dot products, without any arctangent.
+  bool oppositeAnglesExceedPi(VertexIndex b, VertexIndex d, VertexIndex a, VertexIndex c) const {
+    const Eigen::Vector3d ub = points_[a] - points_[b], wb = points_[c] - points_[b];
+    const Eigen::Vector3d ud = points_[a] - points_[d], wd = points_[c] - points_[d];
+    const double sine_b = ub.cross(wb).norm(), sine_d = ud.cross(wd).norm();
+    const double scale = std::sqrt(ub.squaredNorm() * wb.squaredNorm() * ud.squaredNorm() *
+                                   wd.squaredNorm());
+    return sine_b * ud.dot(wd) + ub.dot(wb) * sine_d < -swap_angle_tolerance * scale;
   }
 
   /// Error recovery after the passes: two accepted triangles (a, c, b) and
@@ -511,7 +531,7 @@ private:
           c = candidates_[first].vertices[(k + 1) % 3];
         }
       const VertexIndex b = apexOf(first, a, c), d = apexOf(second, a, c);
-      if (angleAt(b, a, c) + angleAt(d, a, c) <= M_PI + swap_angle_tolerance)
+      if (!oppositeAnglesExceedPi(b, d, a, c))
         continue;
       const CandidateIndex abd = candidateWith(edgeBetween(first, a, b), d);
       const CandidateIndex bcd = candidateWith(edgeBetween(first, b, c), d);

