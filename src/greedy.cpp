@@ -238,8 +238,7 @@ private:
   void buildQueue2(PassStatistics &statistics) {
     queue2_built_ = true;
     for (CandidateIndex t = 0; t < candidates_.size(); ++t) {
-      if (states_[t].state == State::accepted &&
-          candidates_[t].type == CandidateType::ambiguous) {
+      if (states_[t].state == State::accepted && candidates_[t].type == CandidateType::ambiguous) {
         // A fixed type III triangle: pass 1 did not update its context.
         states_[t].context = contextFromScratch(t);
         states_[t].cost = static_cast<float>(freshCost(t));
@@ -488,8 +487,8 @@ private:
     const Eigen::Vector3d ub = points_[a] - points_[b], wb = points_[c] - points_[b];
     const Eigen::Vector3d ud = points_[a] - points_[d], wd = points_[c] - points_[d];
     const double sine_b = ub.cross(wb).norm(), sine_d = ud.cross(wd).norm();
-    const double scale = std::sqrt(ub.squaredNorm() * wb.squaredNorm() * ud.squaredNorm() *
-                                   wd.squaredNorm());
+    const double scale =
+        std::sqrt(ub.squaredNorm() * wb.squaredNorm() * ud.squaredNorm() * wd.squaredNorm());
     return sine_b * ud.dot(wd) + ub.dot(wb) * sine_d < -swap_angle_tolerance * scale;
   }
 

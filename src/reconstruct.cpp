@@ -6,9 +6,9 @@
 #include <pcl_ms/scaffold.h>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Spatial_sort_traits_adapter_3.h>
 #include <CGAL/Hilbert_policy_tags.h>
 #include <CGAL/Hilbert_sort_3.h>
+#include <CGAL/Spatial_sort_traits_adapter_3.h>
 #include <CGAL/property_map.h>
 
 #include <algorithm>

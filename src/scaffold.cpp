@@ -113,7 +113,6 @@ bool isGabriel(const Delaunay &delaunay, CellHandle cell, int i,
   return true;
 }
 
-
 Circle circumcircle(const Eigen::Vector3d &a, const Eigen::Vector3d &b, const Eigen::Vector3d &c) {
   const Eigen::Vector3d u = b - a, v = c - a, w = u.cross(v);
   const double w_squared = w.squaredNorm();
