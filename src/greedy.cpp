@@ -402,6 +402,16 @@ private:
   /// A vertex whose triangles form a closed ring plus other fans: the ring
   /// wins and the extras are undone.
   void keepClosedFanOnly(VertexIndex v) {
+    // A closed fan has at least three triangles whose both edges at v are
+    // full: without them there is nothing to do, and no fans to build.
+    int inner_triangles = 0;
+    for (CandidateIndex u : mesh_.vertexTriangles(v)) {
+      const auto edges = mesh_.edgesAt(u, v);
+      inner_triangles +=
+          mesh_.edgeTriangleCount(edges[0]) == 2 && mesh_.edgeTriangleCount(edges[1]) == 2;
+    }
+    if (inner_triangles < 3)
+      return;
     const auto fans = mesh_.fansAround(v);
     if (fans.size() <= 1) {
       multi_fan_vertex_[v] = false;

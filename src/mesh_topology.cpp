@@ -55,7 +55,7 @@ void MeshTopology::remove(CandidateIndex t) {
 }
 
 std::vector<std::vector<CandidateIndex>> MeshTopology::fansAround(VertexIndex v) const {
-  std::vector<CandidateIndex> triangles = vertex_triangles_[v];
+  std::vector<CandidateIndex> triangles(vertex_triangles_[v].begin(), vertex_triangles_[v].end());
   std::sort(triangles.begin(), triangles.end());
   // Triangles at v are joined through the edges they share at v.
   const auto groups = connectedGroups(triangles.size(), [&](const auto &join) {

@@ -5,6 +5,8 @@
 
 #include <pcl_ms/scaffold.h>
 
+#include <boost/container/small_vector.hpp>
+
 #include <array>
 #include <cstdint>
 #include <limits>
@@ -62,9 +64,11 @@ public:
     return edge_slots_[e][0] == t ? edge_slots_[e][1] : edge_slots_[e][0];
   }
 
-  const std::vector<CandidateIndex> &vertexTriangles(VertexIndex v) const {
-    return vertex_triangles_[v];
-  }
+  /// A vertex of a surface mesh has six triangles on average: up to eight
+  /// are kept inline, so the greedy's many small updates allocate nothing.
+  using VertexTriangles = boost::container::small_vector<CandidateIndex, 8>;
+
+  const VertexTriangles &vertexTriangles(VertexIndex v) const { return vertex_triangles_[v]; }
   /// Edges at v with exactly one triangle.
   int vertexBoundaryEdges(VertexIndex v) const { return vertex_boundary_edges_[v]; }
   /// A vertex whose triangles close around it: nothing more may be added.
@@ -84,7 +88,7 @@ public:
 private:
   const MedialScaffold &scaffold_;
   std::vector<std::array<CandidateIndex, 2>> edge_slots_;
-  std::vector<std::vector<CandidateIndex>> vertex_triangles_;
+  std::vector<VertexTriangles> vertex_triangles_;
   std::vector<std::uint16_t> vertex_boundary_edges_;
   std::vector<bool> in_mesh_;
   std::size_t triangle_count_ = 0;
