@@ -7,8 +7,8 @@
 // each class either method recovered. On the Stanford bunny this shows the
 // ceiling of exact-triangle recall for a method that ranks Gabriel triangles
 // first, and how close to it each method gets.
-#include "peers.h"
 #include "reference_reach.h"
+#include "peers.h"
 #include "tool_support.h"
 
 #include <pcl_ms/io.h>
