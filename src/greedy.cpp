@@ -328,7 +328,7 @@ private:
     }
     bool vertex_face_incidence = false;
     for (VertexIndex v : candidates_[t].vertices) {
-      if (!mesh_.vertexTriangles(v).empty()) {
+      if (mesh_.vertexTriangleCount(v) > 0) {
         const auto edges = mesh_.edgesAt(t, v);
         if (mesh_.edgeTriangleCount(edges[0]) == 0 && mesh_.edgeTriangleCount(edges[1]) == 0)
           vertex_face_incidence = true;
@@ -390,7 +390,7 @@ private:
     for (VertexIndex v : candidates_[t].vertices) {
       if (created_second_fan && mesh_.edgeTriangleCount(mesh_.edgesAt(t, v)[0]) == 1 &&
           mesh_.edgeTriangleCount(mesh_.edgesAt(t, v)[1]) == 1 &&
-          mesh_.vertexTriangles(v).size() > 1) {
+          mesh_.vertexTriangleCount(v) > 1) {
         multi_fan_vertex_[v] = true;
         may_have_several_fans_[v] = true;
       }
@@ -598,7 +598,7 @@ private:
     std::vector<VertexIndex> pending;
     std::vector<bool> is_pending(points_.size(), false);
     for (VertexIndex v = 0; v < points_.size(); ++v)
-      if (may_have_several_fans_[v] && !mesh_.vertexTriangles(v).empty()) {
+      if (may_have_several_fans_[v] && mesh_.vertexTriangleCount(v) > 0) {
         pending.push_back(v);
         is_pending[v] = true;
       }

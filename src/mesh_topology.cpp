@@ -7,7 +7,7 @@ namespace pcl_ms {
 
 MeshTopology::MeshTopology(const MedialScaffold &scaffold, std::size_t vertex_count)
     : scaffold_(scaffold), edge_slots_(scaffold.numberOfEdges(), {no_candidate, no_candidate}),
-      vertex_triangles_(vertex_count), vertex_boundary_edges_(vertex_count, 0),
+      vertex_triangles_(vertex_count), vertex_counts_(vertex_count),
       in_mesh_(scaffold.candidates.size(), false) {}
 
 std::array<EdgeIndex, 2> MeshTopology::edgesAt(CandidateIndex t, VertexIndex v) const {
@@ -27,11 +27,13 @@ void MeshTopology::add(CandidateIndex t) {
     (slots[0] == no_candidate ? slots[0] : slots[1]) = t;
     // An edge with one triangle is a boundary edge of both its vertices.
     const int delta = before == 0 ? 1 : -1;
-    vertex_boundary_edges_[candidate.vertices[k]] += delta;
-    vertex_boundary_edges_[candidate.vertices[(k + 1) % 3]] += delta;
+    vertex_counts_[candidate.vertices[k]].boundary_edges += delta;
+    vertex_counts_[candidate.vertices[(k + 1) % 3]].boundary_edges += delta;
   }
-  for (VertexIndex v : candidate.vertices)
+  for (VertexIndex v : candidate.vertices) {
     vertex_triangles_[v].push_back(t);
+    ++vertex_counts_[v].triangles;
+  }
   in_mesh_[t] = true;
   ++triangle_count_;
 }
@@ -43,12 +45,13 @@ void MeshTopology::remove(CandidateIndex t) {
     (slots[0] == t ? slots[0] : slots[1]) = no_candidate;
     const int after = (slots[0] != no_candidate) + (slots[1] != no_candidate);
     const int delta = after == 0 ? -1 : 1;
-    vertex_boundary_edges_[candidate.vertices[k]] += delta;
-    vertex_boundary_edges_[candidate.vertices[(k + 1) % 3]] += delta;
+    vertex_counts_[candidate.vertices[k]].boundary_edges += delta;
+    vertex_counts_[candidate.vertices[(k + 1) % 3]].boundary_edges += delta;
   }
   for (VertexIndex v : candidate.vertices) {
     auto &list = vertex_triangles_[v];
     list.erase(std::find(list.begin(), list.end(), t));
+    --vertex_counts_[v].triangles;
   }
   in_mesh_[t] = false;
   --triangle_count_;
