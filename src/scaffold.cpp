@@ -322,8 +322,8 @@ private:
                   const Eigen::Vector3d &a = points_[candidate.vertices[0]],
                                         &b = points_[candidate.vertices[1]],
                                         &c = points_[candidate.vertices[2]];
-                  // Most facets of a surface sample's tetrahedra are long: the
-                  // cheap length test comes first.
+                  // About half the facets of a surface sample's tetrahedra are
+                  // too long: the cheap length test comes first.
                   if (std::max({(b - a).squaredNorm(), (c - b).squaredNorm(),
                                 (a - c).squaredNorm()}) >= d_max_squared) {
                     ++out.oversize;

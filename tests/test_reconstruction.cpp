@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <limits>
+#include <numeric>
+#include <random>
 #include <set>
 
 using namespace pcl_ms_test;
@@ -179,6 +181,37 @@ TEST(Determinism, SameInputSameMeshAcrossRunsAndThreads) {
 }
 
 // ---- the PCL class ----------------------------------------------------------------------
+
+// Points are renumbered by their coordinates before anything else, so the
+// order in which the user lists them does not change the surface.
+TEST(Determinism, SameMeshForAnyOrderOfThePoints) {
+  const auto scan = loadXYZ("bun000.pcd");
+  std::vector<std::size_t> order(scan->size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::mt19937 random(20261122);
+  std::shuffle(order.begin(), order.end(), random);
+  auto shuffled = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  for (std::size_t i : order)
+    shuffled->push_back((*scan)[i]);
+
+  const Meshed original = meshCloud<pcl::PointXYZ>(scan);
+  const Meshed reordered = meshCloud<pcl::PointXYZ>(shuffled);
+  ASSERT_FALSE(original.triangles.empty());
+  // The same triangles, named by the original records.
+  auto canonical = [](std::vector<pcl_ms::Triangle> triangles,
+                      const std::vector<std::size_t> *record_of) {
+    for (pcl_ms::Triangle &triangle : triangles) {
+      if (record_of)
+        for (pcl_ms::VertexIndex &v : triangle)
+          v = static_cast<pcl_ms::VertexIndex>((*record_of)[v]);
+      std::sort(triangle.begin(), triangle.end());
+    }
+    std::sort(triangles.begin(), triangles.end());
+    return triangles;
+  };
+  EXPECT_EQ(canonical(original.triangles, nullptr), canonical(reordered.triangles, &order));
+  EXPECT_EQ(original.result.boundary_loops.size(), reordered.result.boundary_loops.size());
+}
 
 TEST(PclClass, ReconstructWithoutInputIsAnErrorNotACrash) {
   pcl::MedialScaffoldReconstruction<pcl::PointXYZ> reconstruction;
