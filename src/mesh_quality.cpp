@@ -4,6 +4,8 @@
 // distances to a reference mesh through CGAL AABB trees.
 #include <pcl_ms/mesh_quality.h>
 
+#include "morton.h"
+
 #include <CGAL/AABB_segment_primitive.h>
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
@@ -585,17 +587,6 @@ struct SampleSet {
   std::size_t deterministic_count = 0; // the random samples follow these
 };
 
-/// Spreads the low 21 bits of a value to every third bit (Morton order).
-std::uint64_t spreadBits(std::uint64_t value) {
-  value &= 0x1fffff;
-  value = (value | value << 32) & 0x1f00000000ffffULL;
-  value = (value | value << 16) & 0x1f0000ff0000ffULL;
-  value = (value | value << 8) & 0x100f00f00f00f00fULL;
-  value = (value | value << 4) & 0x10c30c30c30c30c3ULL;
-  value = (value | value << 2) & 0x1249249249249249ULL;
-  return value;
-}
-
 /// A mesh surface prepared for closest-point queries and for sampling.
 /// Degenerate triangles are kept as their longest edge in a segment tree:
 /// they are part of the surface as a set, and CGAL's point-triangle
@@ -771,12 +762,12 @@ private:
     std::vector<std::pair<std::uint64_t, std::size_t>> coded;
     coded.reserve(order.size());
     for (std::size_t index : order) {
-      std::uint64_t code = 0;
+      std::uint32_t cell[3];
       for (int axis = 0; axis < 3; ++axis) {
         const double scaled = (points[index][axis] - low[axis]) / extent * cells;
-        code |= spreadBits(static_cast<std::uint64_t>(std::clamp(scaled, 0.0, cells))) << axis;
+        cell[axis] = static_cast<std::uint32_t>(std::clamp(scaled, 0.0, cells));
       }
-      coded.emplace_back(code, index);
+      coded.emplace_back(detail::mortonCode(cell[0], cell[1], cell[2]), index);
     }
     std::sort(coded.begin(), coded.end());
     for (std::size_t k = 0; k < coded.size(); ++k)

@@ -5,6 +5,8 @@
 #include <pcl_ms/reconstruct.h>
 #include <pcl_ms/scaffold.h>
 
+#include "morton.h"
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -87,20 +89,6 @@ const float *recordAt(const float *base, std::size_t stride, std::size_t record)
   return reinterpret_cast<const float *>(reinterpret_cast<const char *>(base) + record * stride);
 }
 
-/// 21 bits of each coordinate interleaved: nearby points get nearby codes.
-std::uint64_t mortonCode(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
-  auto spread = [](std::uint64_t v) {
-    v &= 0x1fffff;
-    v = (v | v << 32) & 0x1f00000000ffffULL;
-    v = (v | v << 16) & 0x1f0000ff0000ffULL;
-    v = (v | v << 8) & 0x100f00f00f00f00fULL;
-    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
-    v = (v | v << 2) & 0x1249249249249249ULL;
-    return v;
-  };
-  return spread(x) | spread(y) << 1 | spread(z) << 2;
-}
-
 /// Prepares the distinct, finite points in Morton (Z-curve) order. Every
 /// later stage walks the points' neighbourhoods: with neighbours at nearby
 /// indices their arrays stay in cache, which saves about a fifth of the time
@@ -160,8 +148,9 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
     };
     for (std::size_t i = 0; i < records.size(); ++i) {
       const float *p = recordAt(view.xyz, view.stride, records[i]);
-      keys[i] = {
-          mortonCode(cell(p[0], 0), cell(p[1], 1), cell(p[2], 2)), {p[0], p[1], p[2]}, records[i]};
+      keys[i] = {detail::mortonCode(cell(p[0], 0), cell(p[1], 1), cell(p[2], 2)),
+                 {p[0], p[1], p[2]},
+                 records[i]};
     }
   }
   records.clear();
