@@ -69,10 +69,7 @@ Outcome run(const Configuration &configuration, const pcl::PointCloud<pcl::Point
       seconds = peer.seconds();
       triangles = peer.triangles;
     } else {
-      pcl_ms::PointView view;
-      view.xyz = &cloud[0].x;
-      view.size = cloud.size();
-      view.stride = sizeof(pcl::PointXYZ);
+      const pcl_ms::PointView view = pcl_ms_tools::pointView(cloud);
       pcl_ms::Parameters parameters;
       parameters.bucket_points = configuration.bucket_points;
       parameters.num_threads = configuration.threads;

@@ -66,10 +66,7 @@ int run(int argc, char **argv) {
   std::vector<std::string> names = {"pcl_ms"};
   std::vector<ReferenceReach> reaches;
   {
-    pcl_ms::PointView view;
-    view.xyz = &points[0].x;
-    view.size = points.size();
-    view.stride = sizeof(pcl::PointXYZ);
+    const pcl_ms::PointView view = pcl_ms_tools::pointView(points);
     pcl_ms::Parameters parameters;
     parameters.rho = rho;
     const pcl_ms::Result result = pcl_ms::reconstruct(view, parameters);

@@ -196,10 +196,7 @@ void takePolygons(const std::vector<pcl::Vertices> &polygons, std::vector<pcl_ms
 
 void runPclMs(const pcl::PointCloud<pcl::PointXYZ> &points, const PeerSettings &settings,
               Stages &stages, PeerRun &run) {
-  pcl_ms::PointView view;
-  view.xyz = &points[0].x;
-  view.size = points.size();
-  view.stride = sizeof(pcl::PointXYZ);
+  const pcl_ms::PointView view = pointView(points);
   pcl_ms::Parameters parameters; // the library's defaults
   parameters.num_threads = settings.threads;
   stages.start("reconstruction");

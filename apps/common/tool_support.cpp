@@ -45,4 +45,12 @@ std::vector<Eigen::Vector3d> positions(const pcl::PointCloud<pcl::PointXYZ> &poi
   return result;
 }
 
+pcl_ms::PointView pointView(const pcl::PointCloud<pcl::PointXYZ> &points) {
+  pcl_ms::PointView view;
+  view.xyz = points.empty() ? nullptr : &points[0].x;
+  view.size = points.size();
+  view.stride = sizeof(pcl::PointXYZ);
+  return view;
+}
+
 } // namespace pcl_ms_tools

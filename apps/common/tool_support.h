@@ -4,6 +4,8 @@
 // console and reading a cloud's positions.
 #pragma once
 
+#include <pcl_ms/types.h>
+
 #include <Eigen/Core>
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/console/print.h>
@@ -45,5 +47,8 @@ private:
 std::size_t finitePoints(const pcl::PCLPointCloud2 &cloud, pcl::PointCloud<pcl::PointXYZ> &points);
 
 std::vector<Eigen::Vector3d> positions(const pcl::PointCloud<pcl::PointXYZ> &points);
+
+/// The core's view of the cloud's points (no copy: valid while they are).
+pcl_ms::PointView pointView(const pcl::PointCloud<pcl::PointXYZ> &points);
 
 } // namespace pcl_ms_tools
