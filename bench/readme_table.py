@@ -23,6 +23,11 @@ import random
 import struct
 import sys
 
+# The PLY header parser lives with the other scripts.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "scripts"))
+from ply_header import read_ply_header  # noqa: E402
+
 BEGIN = "<!-- bench-table:begin -->"
 END = "<!-- bench-table:end -->"
 METHODS = ["pcl_ms", "gp3", "poisson", "afsr"]
@@ -44,24 +49,15 @@ PLY_TYPES = {"char": "b", "int8": "b", "uchar": "B", "uint8": "B", "short": "h",
 def read_ply(path):
     with open(path, "rb") as f:
         data = f.read()
-    end = data.find(b"end_header")
-    if not data.startswith(b"ply") or end < 0:
-        die(path + ": not a PLY file")
-    body = data.index(b"\n", end) + 1
-    elements, fmt = [], None
-    for line in data[:end].decode("ascii", "replace").splitlines():
-        words = line.split()
-        if not words:
-            continue
-        if words[0] == "format":
-            fmt = words[1]
-        elif words[0] == "element":
-            elements.append((words[1], int(words[2]), []))
-        elif words[0] == "property" and elements:
-            if words[1] == "list":
-                elements[-1][2].append((words[4], PLY_TYPES[words[2]], PLY_TYPES[words[3]]))
-            else:
-                elements[-1][2].append((words[2], None, PLY_TYPES[words[1]]))
+    try:
+        fmt, header, body = read_ply_header(data, path)
+    except ValueError as error:
+        die(str(error))
+    # (name, count, [(property, list count code or None, value code)])
+    elements = [(element.name, element.count,
+                 [(name, PLY_TYPES[kind[1]], PLY_TYPES[kind[2]]) if isinstance(kind, tuple)
+                  else (name, None, PLY_TYPES[kind]) for name, kind in element.properties])
+                for element in header]
     vertices, triangles = [], []
     if fmt == "ascii":
         tokens = data[body:].split()
@@ -71,7 +67,7 @@ def read_ply(path):
             nonlocal pos
             pos += 1
             return float(tokens[pos - 1]) if code in "fd" else int(tokens[pos - 1])
-    elif fmt in ("binary_little_endian", "binary_big_endian"):
+    else:  # binary: read_ply_header knows no other formats
         order = "<" if fmt == "binary_little_endian" else ">"
         pos = body
 
@@ -80,8 +76,6 @@ def read_ply(path):
             value = struct.unpack_from(order + code, data, pos)[0]
             pos += struct.calcsize(code)
             return value
-    else:
-        die(path + ": unknown PLY format " + str(fmt))
     for name, count, properties in elements:
         for _ in range(count):
             values = {}

@@ -24,13 +24,9 @@ import shutil
 import struct
 import sys
 
-REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from ply_header import read_ply_header
 
-class PlyElement:
-    def __init__(self, name, count):
-        self.name = name
-        self.count = count
-        self.properties = []  # (name, type) or (name, ("list", count_type, item_type))
+REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def read_ascii_ply(path):
@@ -39,37 +35,14 @@ def read_ascii_ply(path):
     Returns (elements, data) where data maps element name to a list of rows;
     a row is a list of the property values as strings (list properties are
     kept as a Python list of strings)."""
-    with open(path, "r", encoding="ascii") as handle:
-        if handle.readline().strip() != "ply":
-            raise ValueError(f"{path}: not a PLY file")
-        elements = []
-        fmt = None
-        while True:
-            line = handle.readline()
-            if not line:
-                raise ValueError(f"{path}: header has no end_header")
-            words = line.split()
-            if not words:
-                continue
-            if words[0] == "format":
-                fmt = words[1]
-            elif words[0] == "element":
-                elements.append(PlyElement(words[1], int(words[2])))
-            elif words[0] == "property":
-                if not elements:
-                    raise ValueError(f"{path}: property before any element")
-                if words[1] == "list":
-                    elements[-1].properties.append((words[4], ("list", words[2], words[3])))
-                else:
-                    elements[-1].properties.append((words[2], words[1]))
-            elif words[0] == "end_header":
-                break
-        if fmt != "ascii":
-            raise ValueError(f"{path}: expected an ASCII PLY, got format {fmt}")
-
-        # The body is a stream of whitespace-separated tokens; list lengths
-        # decide how many tokens a row takes.
-        tokens = handle.read().split()
+    with open(path, "rb") as handle:
+        raw = handle.read()
+    fmt, elements, body = read_ply_header(raw, path)
+    if fmt != "ascii":
+        raise ValueError(f"{path}: expected an ASCII PLY, got format {fmt}")
+    # The body is a stream of whitespace-separated tokens; list lengths
+    # decide how many tokens a row takes.
+    tokens = raw[body:].decode("ascii").split()
     data = {}
     pos = 0
     for element in elements:
