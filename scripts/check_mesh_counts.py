@@ -21,6 +21,8 @@ import sys
 
 import numpy as np
 
+from ply_header import read_ply_header
+
 SCALARS = {
     "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
     "short": "i2", "int16": "i2", "ushort": "u2", "uint16": "u2",
@@ -33,26 +35,14 @@ def read_ply(path):
     """Vertex positions (float64, n x 3) and triangles (int64, m x 3) of a PLY."""
     with open(path, "rb") as f:
         data = f.read()
-    end = data.find(b"end_header")
-    if not data.startswith(b"ply") or end < 0:
-        raise ValueError(f"{path}: not a PLY file")
-    body = data[data.index(b"\n", end) + 1:]
-    elements, fmt = [], None
-    for line in data[:end].decode("ascii", "replace").splitlines():
-        words = line.split()
-        if not words:
-            continue
-        if words[0] == "format":
-            fmt = words[1]
-        elif words[0] == "element":
-            elements.append({"name": words[1], "count": int(words[2]), "props": []})
-        elif words[0] == "property":
-            if words[1] == "list":
-                elements[-1]["props"].append((words[4], SCALARS[words[2]], SCALARS[words[3]]))
-            else:
-                elements[-1]["props"].append((words[2], SCALARS[words[1]], None))
-    if fmt not in ("ascii", "binary_little_endian", "binary_big_endian"):
-        raise ValueError(f"{path}: unknown PLY format {fmt}")
+    fmt, header, offset = read_ply_header(data, path)
+    body = data[offset:]
+    # name, count, props: (property, value type, list index type or None)
+    elements = [{"name": element.name, "count": element.count,
+                 "props": [(name, SCALARS[kind[1]], SCALARS[kind[2]]) if isinstance(kind, tuple)
+                           else (name, SCALARS[kind], None)
+                           for name, kind in element.properties]}
+                for element in header]
     order = "<" if fmt != "binary_big_endian" else ">"
     tokens = body.split() if fmt == "ascii" else None
     at = 0
