@@ -162,7 +162,8 @@ private:
     const Candidate &candidate = candidates_[t];
     for (int k = 0; k < 3; ++k) {
       const EdgeIndex e = candidate.edges[k];
-      // Type III candidates all wait for Q2 during pass 1.
+      // Type III candidates all wait for Q2 during pass 1 (fixed ones are
+      // listed in the first group).
       const CandidateIndex *end =
           queue2_built_ ? scaffold_.edgeEnd(e) : scaffold_.edgeAmbiguousBegin(e);
       for (const CandidateIndex *s = scaffold_.edgeBegin(e); s != end; ++s) {
@@ -238,12 +239,6 @@ private:
   void buildQueue2(PassStatistics &statistics) {
     queue2_built_ = true;
     for (CandidateIndex t = 0; t < candidates_.size(); ++t) {
-      if (states_[t].state == State::accepted && candidates_[t].type == CandidateType::ambiguous) {
-        // A fixed type III triangle: pass 1 did not update its context.
-        states_[t].context = contextFromScratch(t);
-        states_[t].cost = static_cast<float>(freshCost(t));
-        continue;
-      }
       if (states_[t].state != State::queue2)
         continue;
       if (touchesClosedVertex(t)) {

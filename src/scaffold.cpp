@@ -494,11 +494,14 @@ private:
     scaffold_.edge_candidates.resize(3 * candidates.size());
     std::vector<std::uint32_t> cursor(scaffold_.edge_offsets.begin(),
                                       scaffold_.edge_offsets.end() - 1);
-    // (Fixed triangles that are type III candidates stay in the second group:
-    // nothing undoes them, so pass 1 need not update their cost.)
+    // Fixed triangles are in the mesh during pass 1 whatever their type, so
+    // they join the first group.
+    std::vector<bool> is_fixed(candidates.size(), false);
+    for (CandidateIndex t : scaffold_.fixed)
+      is_fixed[t] = true;
     auto fill = [&](bool ambiguous) {
       for (CandidateIndex t = 0; t < candidates.size(); ++t)
-        if ((candidates[t].type == CandidateType::ambiguous) == ambiguous)
+        if ((candidates[t].type == CandidateType::ambiguous && !is_fixed[t]) == ambiguous)
           for (EdgeIndex e : candidates[t].edges)
             scaffold_.edge_candidates[cursor[e]++] = t;
     };

@@ -41,9 +41,9 @@ struct Candidate {
 struct MedialScaffold {
   std::vector<Candidate> candidates;
   std::vector<std::uint32_t> edge_offsets; // edges + 1 entries
-  /// On each edge the type I and II candidates (and fixed ones) come first,
-  /// then the type III ones, each group ascending; this is where the type III
-  /// group of each edge starts. Pass 1 never looks at type III candidates.
+  /// On each edge the type I and II candidates and the fixed ones come
+  /// first, then the other type III ones, each group ascending; this is where
+  /// the second group of each edge starts. Pass 1 never looks at it.
   std::vector<std::uint32_t> edge_ambiguous_offsets; // one per edge
   std::vector<CandidateIndex> edge_candidates;
   /// The candidates of ScaffoldOptions::fixed_triangles, in the same order.
@@ -65,7 +65,7 @@ struct MedialScaffold {
   const CandidateIndex *edgeEnd(EdgeIndex e) const {
     return edge_candidates.data() + edge_offsets[e + 1];
   }
-  /// The first type III candidate on edge e (edgeEnd(e) if none).
+  /// The first non-fixed type III candidate on edge e (edgeEnd(e) if none).
   const CandidateIndex *edgeAmbiguousBegin(EdgeIndex e) const {
     return edge_candidates.data() + edge_ambiguous_offsets[e];
   }
