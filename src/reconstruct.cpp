@@ -14,7 +14,6 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
-#include <numeric>
 #include <sstream>
 #include <tuple>
 
