@@ -7,6 +7,9 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <limits>
 #include <numeric>
@@ -52,6 +55,18 @@ struct EdgeUses {
   std::vector<EdgeUse> uses;
 };
 
+/// Calls work(i) for every i in [0, count), in parallel within the caller's
+/// task arena. Each call must touch only its own outputs, so the result does
+/// not depend on the number of threads.
+template <typename Work> void forEachIndex(std::size_t count, const Work &work) {
+  constexpr std::size_t grain = 1 << 12;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, grain),
+                    [&](const tbb::blocked_range<std::size_t> &range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i)
+                        work(i);
+                    });
+}
+
 EdgeUses edgeUses(const std::vector<Triangle> &triangles) {
   VertexIndex vertex_count = 0;
   for (const Triangle &triangle : triangles)
@@ -72,8 +87,9 @@ EdgeUses edgeUses(const std::vector<Triangle> &triangles) {
       const EdgeKey key = edgeKey(triangles[t][k], triangles[t][(k + 1) % 3]);
       result.uses[cursor[lowVertex(key)]++] = {highVertex(key), t};
     }
-  for (std::size_t v = 0; v < vertex_count; ++v)
+  forEachIndex(vertex_count, [&](std::size_t v) {
     std::sort(result.uses.begin() + offsets[v], result.uses.begin() + offsets[v + 1]);
+  });
   return result;
 }
 
@@ -184,8 +200,9 @@ std::vector<Triangle> triangulateLoop(const std::vector<VertexIndex> &loop,
 
 } // namespace
 
-std::vector<std::vector<VertexIndex>> traceBoundaryLoops(const std::vector<Triangle> &triangles) {
-  const EdgeUses uses = edgeUses(triangles);
+namespace {
+
+std::vector<std::vector<VertexIndex>> boundaryLoops(const EdgeUses &uses) {
   // Boundary edges in both directions, sorted: a CSR of boundary neighbours.
   struct HalfEdge {
     VertexIndex from, to;
@@ -235,11 +252,12 @@ std::vector<std::vector<VertexIndex>> traceBoundaryLoops(const std::vector<Trian
   return loops;
 }
 
-std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen::Vector3d> &points,
-                      int max_edges, double max_side, const std::vector<bool> *only_around) {
+/// fillHoles() given the mesh's boundary loops.
+std::size_t fillLoops(std::vector<Triangle> &triangles, std::vector<std::vector<VertexIndex>> loops,
+                      const std::vector<Eigen::Vector3d> &points, int max_edges, double max_side,
+                      const std::vector<bool> *only_around) {
   if (max_edges < 3)
     return 0;
-  auto loops = traceBoundaryLoops(triangles);
   // Only simple loops: a vertex met twice is a pinch the polygon DP cannot
   // fill; with only_around, only loops that reach the marked vertices.
   loops.erase(std::remove_if(loops.begin(), loops.end(),
@@ -303,7 +321,76 @@ std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen:
   return filled;
 }
 
+} // namespace
+
+std::vector<std::vector<VertexIndex>> traceBoundaryLoops(const std::vector<Triangle> &triangles) {
+  return boundaryLoops(edgeUses(triangles));
+}
+
+std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen::Vector3d> &points,
+                      int max_edges, double max_side, const std::vector<bool> *only_around) {
+  if (max_edges < 3)
+    return 0;
+  return fillLoops(triangles, traceBoundaryLoops(triangles), points, max_edges, max_side,
+                   only_around);
+}
+
 namespace {
+
+/// Union-find over triangles that keeps each triangle's flip relative to its
+/// root. The smaller index is always the root, so a set's root is its first
+/// triangle whatever order the joins come in.
+class ParityForest {
+public:
+  enum class Join { joined, consistent, conflict };
+
+  explicit ParityForest(std::size_t size) : parent_(size), flip_to_parent_(size, 0) {
+    std::iota(parent_.begin(), parent_.end(), 0u);
+  }
+
+  /// The root of t, and whether t is flipped relative to it.
+  std::pair<std::uint32_t, std::uint8_t> find(std::uint32_t t) {
+    std::uint8_t flip = 0;
+    std::uint32_t root = t;
+    while (parent_[root] != root) {
+      flip ^= flip_to_parent_[root];
+      root = parent_[root];
+    }
+    // Path compression: point every triangle on the path at the root.
+    for (std::uint8_t rest = flip; parent_[t] != t;) {
+      const std::uint32_t next = parent_[t];
+      const std::uint8_t step = flip_to_parent_[t];
+      parent_[t] = root;
+      flip_to_parent_[t] = rest;
+      rest ^= step;
+      t = next;
+    }
+    return {root, flip};
+  }
+
+  /// Puts t and u in one set with their flips differing by must_differ; when
+  /// they already share a set, says whether their flips agree with that.
+  Join join(std::uint32_t t, std::uint32_t u, bool must_differ) {
+    const auto [t_root, t_flip] = find(t);
+    const auto [u_root, u_flip] = find(u);
+    if (t_root == u_root)
+      return (t_flip ^ u_flip) == must_differ ? Join::consistent : Join::conflict;
+    const std::uint32_t root = std::min(t_root, u_root);
+    const std::uint32_t child = std::max(t_root, u_root);
+    parent_[child] = root;
+    flip_to_parent_[child] = static_cast<std::uint8_t>(t_flip ^ u_flip ^ must_differ);
+    return Join::joined;
+  }
+
+private:
+  std::vector<std::uint32_t> parent_;
+  std::vector<std::uint8_t> flip_to_parent_;
+};
+
+// Pairs bending less than this (about 30 degrees) are joined before the
+// rest without sorting (see orientComponents); any value gives the same
+// orientation, this one leaves few pairs to sort on a smooth surface.
+constexpr double kruskal_flat_bending = 0.5;
 
 /// Two triangles sharing a manifold edge, and how much the surface bends
 /// there (computed only where orientation needs it).
@@ -312,8 +399,7 @@ struct ManifoldPair {
   VertexIndex a, b; // the shared edge
 };
 
-std::vector<ManifoldPair> manifoldPairs(const std::vector<Triangle> &triangles) {
-  const EdgeUses uses = edgeUses(triangles);
+std::vector<ManifoldPair> manifoldPairs(const EdgeUses &uses) {
   std::size_t count_of_pairs = 0;
   forEachEdge(uses, [&](EdgeKey, std::size_t, std::size_t count) { count_of_pairs += count == 2; });
   std::vector<ManifoldPair> pairs;
@@ -473,12 +559,15 @@ std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_co
   return before - triangles.size();
 }
 
-std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
-                                            const std::vector<Eigen::Vector3d> &points,
-                                            std::vector<std::uint32_t> &triangle_component,
-                                            std::vector<bool> &component_orientable) {
+namespace {
+
+/// orientComponents() given the mesh's edge uses, which orienting leaves valid.
+std::vector<std::uint32_t> orientWithUses(std::vector<Triangle> &triangles, const EdgeUses &uses,
+                                          const std::vector<Eigen::Vector3d> &points,
+                                          std::vector<std::uint32_t> &triangle_component,
+                                          std::vector<bool> &component_orientable) {
   const std::uint32_t unvisited = std::numeric_limits<std::uint32_t>::max();
-  const std::vector<ManifoldPair> pairs = manifoldPairs(triangles);
+  const std::vector<ManifoldPair> pairs = manifoldPairs(uses);
   std::vector<std::uint32_t> offsets(triangles.size() + 1, 0);
   for (const ManifoldPair &pair : pairs) {
     ++offsets[pair.first + 1];
@@ -528,73 +617,77 @@ std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
       }
     }
   }
-  for (const ManifoldPair &pair : pairs)
-    if (!consistentlyOriented(triangles[pair.first], triangles[pair.second]))
-      component_orientable[triangle_component[pair.first]] = false;
+  // Per pair, whether its triangles disagree now; read until Kruskal flips.
+  std::vector<std::uint8_t> inconsistent(pairs.size());
+  forEachIndex(pairs.size(), [&](std::size_t p) {
+    inconsistent[p] = !consistentlyOriented(triangles[pairs[p].first], triangles[pairs[p].second]);
+  });
+  for (std::size_t p = 0; p < pairs.size(); ++p)
+    if (inconsistent[p])
+      component_orientable[triangle_component[pairs[p].first]] = false;
 
   // Where none exists, orientation follows a maximum spanning forest on
   // flatness (pairs joined flattest first, Kruskal's order), so that the
   // edges left inconsistent are the component's most bent ones, i.e. where
-  // the twist is. A union-find keeps each triangle's flip relative to its
-  // root; each component's first triangle keeps its orientation.
+  // the twist is. Each component's first triangle keeps its orientation.
+  auto inTwistedComponent = [&](std::size_t p) {
+    return !component_orientable[triangle_component[pairs[p].first]];
+  };
+  const bool any_twisted = std::find(component_orientable.begin(), component_orientable.end(),
+                                     false) != component_orientable.end();
   std::vector<double> bending; // per pair, where a component needs it
-  std::vector<std::pair<double, std::uint32_t>> flattest_first; // bending, pair
-  for (std::uint32_t p = 0; p < pairs.size(); ++p)
-    if (!component_orientable[triangle_component[pairs[p].first]]) {
-      bending.resize(pairs.size(), 0.0);
-      bending[p] = bendingAt(pairs[p], triangles, points);
-      flattest_first.emplace_back(bending[p], p);
-    }
-  if (!flattest_first.empty()) {
-    std::sort(flattest_first.begin(), flattest_first.end());
-    std::vector<std::uint32_t> parent(triangles.size());
-    std::vector<std::uint8_t> flip_to_parent(triangles.size(), 0);
-    std::iota(parent.begin(), parent.end(), 0u);
-    // The root of t, and whether t is flipped relative to it.
-    auto find = [&](std::uint32_t t) {
-      std::uint8_t flip = 0;
-      std::uint32_t root = t;
-      while (parent[root] != root) {
-        flip ^= flip_to_parent[root];
-        root = parent[root];
-      }
-      // Path compression: point every triangle on the path at the root.
-      for (std::uint8_t rest = flip; parent[t] != t;) {
-        const std::uint32_t next = parent[t];
-        const std::uint8_t step = flip_to_parent[t];
-        parent[t] = root;
-        flip_to_parent[t] = rest;
-        rest ^= step;
-        t = next;
-      }
-      return std::make_pair(root, flip);
-    };
-    for (const auto &[flatness, p] : flattest_first) {
+  if (any_twisted) {
+    bending.resize(pairs.size(), 0.0);
+    forEachIndex(pairs.size(), [&](std::size_t p) {
+      if (inTwistedComponent(p))
+        bending[p] = bendingAt(pairs[p], triangles, points);
+    });
+  }
+  std::vector<std::uint32_t> flat_pairs, bent_pairs;
+  for (std::uint32_t p = 0; p < pairs.size() && any_twisted; ++p)
+    if (inTwistedComponent(p))
+      (bending[p] < kruskal_flat_bending ? flat_pairs : bent_pairs).push_back(p);
+  if (!flat_pairs.empty() || !bent_pairs.empty()) {
+    ParityForest forest(triangles.size());
+    auto join = [&](std::uint32_t p) {
       const ManifoldPair &pair = pairs[p];
       // Flipping exactly one of the two changes whether they agree.
-      const std::uint8_t must_differ =
-          consistentlyOriented(triangles[pair.first], triangles[pair.second]) ? 0 : 1;
-      const auto [first_root, first_flip] = find(pair.first);
-      const auto [second_root, second_flip] = find(pair.second);
-      if (first_root == second_root)
-        continue; // a cycle: consistent or not, the tree decides
-      // The smaller index becomes the root, so the component's first triangle ends as root.
-      const std::uint32_t root = std::min(first_root, second_root);
-      const std::uint32_t child = std::max(first_root, second_root);
-      parent[child] = root;
-      flip_to_parent[child] = first_flip ^ second_flip ^ must_differ;
+      return forest.join(pair.first, pair.second, inconsistent[p]);
+    };
+    auto flattestFirst = [&](std::vector<std::uint32_t> &order) {
+      std::sort(order.begin(), order.end(), [&](std::uint32_t p, std::uint32_t q) {
+        return bending[p] < bending[q] || (bending[p] == bending[q] && p < q);
+      });
+    };
+    // Kruskal's forest after the flat pairs does not depend on their order
+    // when no cycle of flat pairs is twisted: the same triangles end up
+    // together with the same relative flips. So they are joined unsorted,
+    // and only the few bent pairs are sorted. A twist among flat pairs
+    // needs Kruskal's order throughout.
+    bool flat_cycle_twisted = false;
+    for (std::uint32_t p : flat_pairs)
+      flat_cycle_twisted |= join(p) == ParityForest::Join::conflict;
+    if (flat_cycle_twisted) {
+      forest = ParityForest(triangles.size());
+      bent_pairs.insert(bent_pairs.end(), flat_pairs.begin(), flat_pairs.end());
     }
+    flattestFirst(bent_pairs);
+    for (std::uint32_t p : bent_pairs)
+      join(p);
     for (std::uint32_t t = 0; t < triangles.size(); ++t)
-      if (!component_orientable[triangle_component[t]] && find(t).second)
+      if (!component_orientable[triangle_component[t]] && forest.find(t).second)
         std::swap(triangles[t][1], triangles[t][2]);
   }
   std::vector<std::uint32_t> sharply_bent_conflicts;
-  for (std::uint32_t p = 0; p < pairs.size(); ++p) {
-    const ManifoldPair &pair = pairs[p];
-    if (!component_orientable[triangle_component[pair.first]] &&
-        !consistentlyOriented(triangles[pair.first], triangles[pair.second]) &&
-        bending[p] > max_untwist_bending)
-      sharply_bent_conflicts.push_back(pair.first);
+  if (any_twisted) {
+    forEachIndex(pairs.size(), [&](std::size_t p) {
+      inconsistent[p] =
+          inTwistedComponent(p) && bending[p] > max_untwist_bending &&
+          !consistentlyOriented(triangles[pairs[p].first], triangles[pairs[p].second]);
+    });
+    for (std::size_t p = 0; p < pairs.size(); ++p)
+      if (inconsistent[p])
+        sharply_bent_conflicts.push_back(pairs[p].first);
   }
   for (std::uint32_t component = 0; component < members.size(); ++component) {
     if (!component_orientable[component])
@@ -609,6 +702,16 @@ std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
         std::swap(triangles[t][1], triangles[t][2]);
   }
   return sharply_bent_conflicts;
+}
+
+} // namespace
+
+std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
+                                            const std::vector<Eigen::Vector3d> &points,
+                                            std::vector<std::uint32_t> &triangle_component,
+                                            std::vector<bool> &component_orientable) {
+  return orientWithUses(triangles, edgeUses(triangles), points, triangle_component,
+                        component_orientable);
 }
 
 std::size_t removeTwistedFans(std::vector<Triangle> &triangles,
@@ -652,20 +755,31 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
                               const std::vector<Eigen::Vector3d> &points, int fill_holes_max_edges,
                               double max_side, const std::vector<bool> *anchored_vertices) {
   FinishedSurface surface;
-  surface.holes_filled = fillHoles(triangles, points, fill_holes_max_edges, max_side);
-  std::vector<std::uint32_t> twisted =
-      orientComponents(triangles, points, surface.triangle_component, surface.component_orientable);
+  // Edge uses are rebuilt only when triangles come or go: orienting keeps them.
+  EdgeUses uses = edgeUses(triangles);
+  auto fillFrom = [&](int max_edges, const std::vector<bool> *only_around) {
+    const std::size_t filled =
+        fillLoops(triangles, boundaryLoops(uses), points, max_edges, max_side, only_around);
+    if (filled > 0)
+      uses = edgeUses(triangles);
+    surface.holes_filled += filled;
+  };
+  auto orient = [&] {
+    return orientWithUses(triangles, uses, points, surface.triangle_component,
+                          surface.component_orientable);
+  };
+  fillFrom(fill_holes_max_edges, nullptr);
+  std::vector<std::uint32_t> twisted = orient();
   for (int round = 0; round < max_untwist_rounds && !twisted.empty(); ++round) {
     std::vector<bool> touched;
     surface.twist_triangles_removed +=
         removeTwistedFans(triangles, points, twisted, touched, anchored_vertices);
+    uses = edgeUses(triangles);
     // The loops that removal opened are ours to close, whatever the user's limit.
-    surface.holes_filled +=
-        fillHoles(triangles, points, max_untwist_loop_edges, max_side, &touched);
-    twisted = orientComponents(triangles, points, surface.triangle_component,
-                               surface.component_orientable);
+    fillFrom(max_untwist_loop_edges, &touched);
+    twisted = orient();
   }
-  surface.boundary_loops = traceBoundaryLoops(triangles);
+  surface.boundary_loops = boundaryLoops(uses);
   surface.triangles = std::move(triangles);
   return surface;
 }

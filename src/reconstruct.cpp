@@ -7,6 +7,8 @@
 
 #include "morton.h"
 
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -321,9 +323,14 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
       for (VertexIndex v : triangle)
         anchored[v] = true;
   }
-  FinishedSurface surface =
-      finishSurface(std::move(triangles), prepared.positions, parameters.fill_holes_max_edges,
-                    result.d_max, anchored.empty() ? nullptr : &anchored);
+  // The finish stage's parallel loops use the threads the user allowed.
+  FinishedSurface surface;
+  tbb::task_arena(parameters.num_threads > 0 ? parameters.num_threads : tbb::task_arena::automatic)
+      .execute([&] {
+        surface =
+            finishSurface(std::move(triangles), prepared.positions, parameters.fill_holes_max_edges,
+                          result.d_max, anchored.empty() ? nullptr : &anchored);
+      });
   // Back to the user's records.
   for (Triangle &triangle : surface.triangles)
     for (VertexIndex &v : triangle)
