@@ -8,6 +8,8 @@
 #include <pcl_ms/mesh_topology.h>
 #include <pcl_ms/scaffold.h>
 
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <set>
 
@@ -308,6 +310,27 @@ TEST(Finish, GentleMoebiusBandIsKeptWhole) {
   ASSERT_EQ(surface.component_orientable.size(), 1u);
   EXPECT_FALSE(surface.component_orientable[0]);
   EXPECT_EQ(surface.boundary_loops.size(), 1u);
+}
+
+TEST(Finish, SameSurfaceForAnyNumberOfThreads) {
+  // Long enough for the parallel loops to split the work; non-orientable,
+  // so the spanning-forest orientation runs as well.
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Triangle> band;
+  moebiusBand(6000, 0.2, points, band);
+  auto finishWith = [&](int threads) {
+    FinishedSurface surface;
+    tbb::task_arena(threads).execute([&] { surface = finishSurface(band, points, 8, 10.0); });
+    return surface;
+  };
+  const FinishedSurface one = finishWith(1);
+  ASSERT_EQ(one.component_orientable, std::vector<bool>{false});
+  for (int threads : {2, 8}) {
+    const FinishedSurface several = finishWith(threads);
+    EXPECT_EQ(several.triangles, one.triangles) << threads << " threads";
+    EXPECT_EQ(several.boundary_loops, one.boundary_loops) << threads << " threads";
+    EXPECT_EQ(several.triangle_component, one.triangle_component) << threads << " threads";
+  }
 }
 
 TEST(Finish, MoebiusStripIsReportedNonOrientable) {
