@@ -561,13 +561,13 @@ std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_co
 
 namespace {
 
-/// orientComponents() given the mesh's edge uses, which orienting leaves valid.
-std::vector<std::uint32_t> orientWithUses(std::vector<Triangle> &triangles, const EdgeUses &uses,
-                                          const std::vector<Eigen::Vector3d> &points,
-                                          std::vector<std::uint32_t> &triangle_component,
-                                          std::vector<bool> &component_orientable) {
+/// orientComponents() given the mesh's manifold pairs.
+std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
+                                       const std::vector<ManifoldPair> &pairs,
+                                       const std::vector<Eigen::Vector3d> &points,
+                                       std::vector<std::uint32_t> &triangle_component,
+                                       std::vector<bool> &component_orientable) {
   const std::uint32_t unvisited = std::numeric_limits<std::uint32_t>::max();
-  const std::vector<ManifoldPair> pairs = manifoldPairs(uses);
   std::vector<std::uint32_t> offsets(triangles.size() + 1, 0);
   for (const ManifoldPair &pair : pairs) {
     ++offsets[pair.first + 1];
@@ -710,8 +710,8 @@ std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
                                             const std::vector<Eigen::Vector3d> &points,
                                             std::vector<std::uint32_t> &triangle_component,
                                             std::vector<bool> &component_orientable) {
-  return orientWithUses(triangles, edgeUses(triangles), points, triangle_component,
-                        component_orientable);
+  return orientPairs(triangles, manifoldPairs(edgeUses(triangles)), points, triangle_component,
+                     component_orientable);
 }
 
 std::size_t removeTwistedFans(std::vector<Triangle> &triangles,
@@ -755,31 +755,30 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
                               const std::vector<Eigen::Vector3d> &points, int fill_holes_max_edges,
                               double max_side, const std::vector<bool> *anchored_vertices) {
   FinishedSurface surface;
-  // Edge uses are rebuilt only when triangles come or go: orienting keeps them.
-  EdgeUses uses = edgeUses(triangles);
-  auto fillFrom = [&](int max_edges, const std::vector<bool> *only_around) {
+  // Edge uses are built once per set of triangles. Orienting keeps the set,
+  // so the boundary loops are traced before it and the uses freed: the
+  // orientation's own arrays are as large.
+  auto fillThenOrient = [&](int max_edges, const std::vector<bool> *only_around) {
+    EdgeUses uses = edgeUses(triangles);
     const std::size_t filled =
         fillLoops(triangles, boundaryLoops(uses), points, max_edges, max_side, only_around);
     if (filled > 0)
       uses = edgeUses(triangles);
     surface.holes_filled += filled;
+    surface.boundary_loops = boundaryLoops(uses);
+    std::vector<ManifoldPair> pairs = manifoldPairs(uses);
+    uses = EdgeUses();
+    return orientPairs(triangles, pairs, points, surface.triangle_component,
+                       surface.component_orientable);
   };
-  auto orient = [&] {
-    return orientWithUses(triangles, uses, points, surface.triangle_component,
-                          surface.component_orientable);
-  };
-  fillFrom(fill_holes_max_edges, nullptr);
-  std::vector<std::uint32_t> twisted = orient();
+  std::vector<std::uint32_t> twisted = fillThenOrient(fill_holes_max_edges, nullptr);
   for (int round = 0; round < max_untwist_rounds && !twisted.empty(); ++round) {
     std::vector<bool> touched;
     surface.twist_triangles_removed +=
         removeTwistedFans(triangles, points, twisted, touched, anchored_vertices);
-    uses = edgeUses(triangles);
     // The loops that removal opened are ours to close, whatever the user's limit.
-    fillFrom(max_untwist_loop_edges, &touched);
-    twisted = orient();
+    twisted = fillThenOrient(max_untwist_loop_edges, &touched);
   }
-  surface.boundary_loops = boundaryLoops(uses);
   surface.triangles = std::move(triangles);
   return surface;
 }
