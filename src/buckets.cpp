@@ -439,7 +439,11 @@ private:
     slab.low[node.axis] = std::max(slab.low[node.axis], node.split - half_width);
     slab.high[node.axis] = std::min(slab.high[node.axis], node.split + half_width);
     const std::vector<VertexIndex> zone = tree_.gather(slab);
-    auto inZone = [&](VertexIndex v) { return std::binary_search(zone.begin(), zone.end(), v); };
+    // Every triangle of the subtree is tested: a lookup table, not a search.
+    std::vector<bool> in_zone(points_.size(), false);
+    for (VertexIndex v : zone)
+      in_zone[v] = true;
+    auto inZone = [&](VertexIndex v) { return in_zone[v]; };
 
     std::vector<Triangle> subtree_triangles;
     std::vector<Triangle> fixed;

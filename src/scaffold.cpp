@@ -245,26 +245,28 @@ private:
     // A fixed stride of cells estimates the median as well as all of them.
     const std::size_t stride = std::max<std::size_t>(1, cells_.size() / median_sample_cells);
     std::vector<std::vector<float>> chunk_radii(chunkCount(cells_.size()));
-    forEachChunk(
-        cells_.size(), options_.num_threads,
-        [&](std::size_t chunk, std::size_t begin, std::size_t end) {
-          std::vector<float> &radii = chunk_radii[chunk];
-          for (std::size_t index = begin; index < end; ++index) {
-            if (index % stride != 0)
-              continue;
-            forEachOwnedFacet(
-                delaunay, cells_[index], [&](CellHandle cell, int i, const auto &vertices) {
-                  const KernelPoint &a = vertices[0]->point(), &b = vertices[1]->point(),
-                                    &c = vertices[2]->point();
-                  if (CGAL::collinear(a, b, c))
-                    return;
-                  if (!scaffold_.planar && !isGabriel(delaunay, cell, i, vertices))
-                    return;
-                  radii.push_back(
-                      static_cast<float>(circumcircle(toEigen(a), toEigen(b), toEigen(c)).radius));
-                });
-          }
-        });
+    forEachChunk(cells_.size(), options_.num_threads,
+                 [&](std::size_t chunk, std::size_t begin, std::size_t end) {
+                   std::vector<float> &radii = chunk_radii[chunk];
+                   for (std::size_t index = begin; index < end; ++index) {
+                     if (index % stride != 0)
+                       continue;
+                     forEachOwnedFacet(
+                         delaunay, cells_[index],
+                         [&](CellHandle cell, int i, const auto &vertices) {
+                           const KernelPoint &a = vertices[0]->point(), &b = vertices[1]->point(),
+                                             &c = vertices[2]->point();
+                           if (CGAL::collinear(a, b, c))
+                             return;
+                           const Eigen::Vector3d p = toEigen(a), q = toEigen(b), r = toEigen(c);
+                           const Circle circle = circumcircle(p, q, r);
+                           if (!scaffold_.planar && !isGabriel(delaunay, cell, i, vertices, circle,
+                                                               triangleShape(p, q, r).compactness))
+                             return;
+                           radii.push_back(static_cast<float>(circle.radius));
+                         });
+                   }
+                 });
     std::vector<float> radii;
     for (const auto &chunk : chunk_radii)
       radii.insert(radii.end(), chunk.begin(), chunk.end());
