@@ -388,7 +388,7 @@ private:
 };
 
 // Pairs bending less than this (about 30 degrees) are joined before the
-// rest without sorting (see orientComponents); any value gives the same
+// rest without sorting (see orientPairs); any value gives the same
 // orientation, this one leaves few pairs to sort on a smooth surface.
 constexpr double kruskal_flat_bending = 0.5;
 
@@ -636,17 +636,17 @@ std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
   const bool any_twisted = std::find(component_orientable.begin(), component_orientable.end(),
                                      false) != component_orientable.end();
   std::vector<double> bending; // per pair, where a component needs it
+  std::vector<std::uint32_t> flat_pairs, bent_pairs;
   if (any_twisted) {
     bending.resize(pairs.size(), 0.0);
     forEachIndex(pairs.size(), [&](std::size_t p) {
       if (inTwistedComponent(p))
         bending[p] = bendingAt(pairs[p], triangles, points);
     });
+    for (std::uint32_t p = 0; p < pairs.size(); ++p)
+      if (inTwistedComponent(p))
+        (bending[p] < kruskal_flat_bending ? flat_pairs : bent_pairs).push_back(p);
   }
-  std::vector<std::uint32_t> flat_pairs, bent_pairs;
-  for (std::uint32_t p = 0; p < pairs.size() && any_twisted; ++p)
-    if (inTwistedComponent(p))
-      (bending[p] < kruskal_flat_bending ? flat_pairs : bent_pairs).push_back(p);
   if (!flat_pairs.empty() || !bent_pairs.empty()) {
     ParityForest forest(triangles.size());
     auto join = [&](std::uint32_t p) {
@@ -672,6 +672,7 @@ std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
       bent_pairs.insert(bent_pairs.end(), flat_pairs.begin(), flat_pairs.end());
     }
     flattestFirst(bent_pairs);
+    // A pair that closes a cycle leaves the forest as it is, consistent or not.
     for (std::uint32_t p : bent_pairs)
       join(p);
     for (std::uint32_t t = 0; t < triangles.size(); ++t)
@@ -680,13 +681,14 @@ std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
   }
   std::vector<std::uint32_t> sharply_bent_conflicts;
   if (any_twisted) {
+    std::vector<std::uint8_t> sharp_conflict(pairs.size());
     forEachIndex(pairs.size(), [&](std::size_t p) {
-      inconsistent[p] =
+      sharp_conflict[p] =
           inTwistedComponent(p) && bending[p] > max_untwist_bending &&
           !consistentlyOriented(triangles[pairs[p].first], triangles[pairs[p].second]);
     });
     for (std::size_t p = 0; p < pairs.size(); ++p)
-      if (inconsistent[p])
+      if (sharp_conflict[p])
         sharply_bent_conflicts.push_back(pairs[p].first);
   }
   for (std::uint32_t component = 0; component < members.size(); ++component) {
@@ -766,7 +768,7 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
       uses = edgeUses(triangles);
     surface.holes_filled += filled;
     surface.boundary_loops = boundaryLoops(uses);
-    std::vector<ManifoldPair> pairs = manifoldPairs(uses);
+    const std::vector<ManifoldPair> pairs = manifoldPairs(uses);
     uses = EdgeUses();
     return orientPairs(triangles, pairs, points, surface.triangle_component,
                        surface.component_orientable);
