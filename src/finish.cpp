@@ -635,35 +635,27 @@ std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
   };
   const bool any_twisted = std::find(component_orientable.begin(), component_orientable.end(),
                                      false) != component_orientable.end();
-  std::vector<double> bending; // per pair, where a component needs it
-  std::vector<std::uint32_t> flat_pairs, bent_pairs;
+  std::vector<std::uint32_t> sharply_bent_conflicts;
   if (any_twisted) {
-    bending.resize(pairs.size(), 0.0);
+    std::vector<double> bending(pairs.size(), 0.0); // in twisted components only
     forEachIndex(pairs.size(), [&](std::size_t p) {
       if (inTwistedComponent(p))
         bending[p] = bendingAt(pairs[p], triangles, points);
     });
-    for (std::uint32_t p = 0; p < pairs.size(); ++p)
-      if (inTwistedComponent(p))
-        (bending[p] < kruskal_flat_bending ? flat_pairs : bent_pairs).push_back(p);
-  }
-  if (!flat_pairs.empty() || !bent_pairs.empty()) {
-    ParityForest forest(triangles.size());
-    auto join = [&](std::uint32_t p) {
-      const ManifoldPair &pair = pairs[p];
-      // Flipping exactly one of the two changes whether they agree.
-      return forest.join(pair.first, pair.second, inconsistent[p]);
-    };
-    auto flattestFirst = [&](std::vector<std::uint32_t> &order) {
-      std::sort(order.begin(), order.end(), [&](std::uint32_t p, std::uint32_t q) {
-        return bending[p] < bending[q] || (bending[p] == bending[q] && p < q);
-      });
-    };
     // Kruskal's forest after the flat pairs does not depend on their order
     // when no cycle of flat pairs is twisted: the same triangles end up
     // together with the same relative flips. So they are joined unsorted,
     // and only the few bent pairs are sorted. A twist among flat pairs
     // needs Kruskal's order throughout.
+    std::vector<std::uint32_t> flat_pairs, bent_pairs;
+    for (std::uint32_t p = 0; p < pairs.size(); ++p)
+      if (inTwistedComponent(p))
+        (bending[p] < kruskal_flat_bending ? flat_pairs : bent_pairs).push_back(p);
+    ParityForest forest(triangles.size());
+    // Flipping exactly one of a pair changes whether the two agree.
+    auto join = [&](std::uint32_t p) {
+      return forest.join(pairs[p].first, pairs[p].second, inconsistent[p]);
+    };
     bool flat_cycle_twisted = false;
     for (std::uint32_t p : flat_pairs)
       flat_cycle_twisted |= join(p) == ParityForest::Join::conflict;
@@ -671,16 +663,16 @@ std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
       forest = ParityForest(triangles.size());
       bent_pairs.insert(bent_pairs.end(), flat_pairs.begin(), flat_pairs.end());
     }
-    flattestFirst(bent_pairs);
+    std::sort(bent_pairs.begin(), bent_pairs.end(), [&](std::uint32_t p, std::uint32_t q) {
+      return bending[p] < bending[q] || (bending[p] == bending[q] && p < q);
+    });
     // A pair that closes a cycle leaves the forest as it is, consistent or not.
     for (std::uint32_t p : bent_pairs)
       join(p);
     for (std::uint32_t t = 0; t < triangles.size(); ++t)
       if (!component_orientable[triangle_component[t]] && forest.find(t).second)
         std::swap(triangles[t][1], triangles[t][2]);
-  }
-  std::vector<std::uint32_t> sharply_bent_conflicts;
-  if (any_twisted) {
+
     std::vector<std::uint8_t> sharp_conflict(pairs.size());
     forEachIndex(pairs.size(), [&](std::size_t p) {
       sharp_conflict[p] =
@@ -762,12 +754,14 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
   // orientation's own arrays are as large.
   auto fillThenOrient = [&](int max_edges, const std::vector<bool> *only_around) {
     EdgeUses uses = edgeUses(triangles);
-    const std::size_t filled =
-        fillLoops(triangles, boundaryLoops(uses), points, max_edges, max_side, only_around);
-    if (filled > 0)
-      uses = edgeUses(triangles);
-    surface.holes_filled += filled;
     surface.boundary_loops = boundaryLoops(uses);
+    const std::size_t filled =
+        fillLoops(triangles, surface.boundary_loops, points, max_edges, max_side, only_around);
+    if (filled > 0) {
+      uses = edgeUses(triangles);
+      surface.boundary_loops = boundaryLoops(uses);
+    }
+    surface.holes_filled += filled;
     const std::vector<ManifoldPair> pairs = manifoldPairs(uses);
     uses = EdgeUses();
     return orientPairs(triangles, pairs, points, surface.triangle_component,
