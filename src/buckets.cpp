@@ -5,6 +5,8 @@
 #include <pcl_ms/reconstruct.h>
 #include <pcl_ms/scaffold.h>
 
+#include "threads.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -319,8 +321,7 @@ public:
     const double estimated_d_med = d_med_per_spacing * spacing;
     margin_ = (parameters_.rho + margin_context_in_d_med) * estimated_d_med;
 
-    tbb::task_arena arena(parameters_.num_threads > 0 ? parameters_.num_threads
-                                                      : tbb::task_arena::automatic);
+    tbb::task_arena arena = detail::threadArena(parameters_.num_threads);
     Clock::time_point stage = Clock::now();
     std::vector<BucketOutcome> leaf_outcomes(leaves.size());
     std::vector<std::size_t> margin_points(leaves.size(), 0);

@@ -6,8 +6,7 @@
 #include <pcl_ms/scaffold.h>
 
 #include "morton.h"
-
-#include <tbb/task_arena.h>
+#include "threads.h"
 
 #include <algorithm>
 #include <array>
@@ -325,12 +324,11 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
   }
   // The finish stage's parallel loops use the threads the user allowed.
   FinishedSurface surface;
-  tbb::task_arena(parameters.num_threads > 0 ? parameters.num_threads : tbb::task_arena::automatic)
-      .execute([&] {
-        surface =
-            finishSurface(std::move(triangles), prepared.positions, parameters.fill_holes_max_edges,
-                          result.d_max, anchored.empty() ? nullptr : &anchored);
-      });
+  detail::threadArena(parameters.num_threads).execute([&] {
+    surface =
+        finishSurface(std::move(triangles), prepared.positions, parameters.fill_holes_max_edges,
+                      result.d_max, anchored.empty() ? nullptr : &anchored);
+  });
   // Back to the user's records.
   for (Triangle &triangle : surface.triangles)
     for (VertexIndex &v : triangle)

@@ -3,15 +3,15 @@
 #include <pcl_ms/reconstruct.h>
 #include <pcl_ms/scaffold.h>
 
+#include "threads.h"
+
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Delaunay_triangulation_cell_base_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_cell_base_with_info_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
-#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
@@ -143,8 +143,7 @@ void forEachChunk(std::size_t items, int num_threads, const ChunkWork &work) {
       work(chunk, chunk * cells_per_chunk, std::min(items, (chunk + 1) * cells_per_chunk));
     return;
   }
-  tbb::task_arena arena(num_threads > 0 ? num_threads : tbb::task_arena::automatic);
-  arena.execute(run);
+  detail::threadArena(num_threads).execute(run);
 }
 
 double median(std::vector<float> &values) {
