@@ -333,6 +333,50 @@ TEST(Finish, SameSurfaceForAnyNumberOfThreads) {
   }
 }
 
+TEST(Finish, TwistIsCutWhereTheBandFoldsOverItself) {
+  // A flat ring of quads whose last quad is glued with a half twist, i.e.
+  // crossed over itself: every edge is flat except around that quad. The
+  // inconsistent edge that orientation must leave belongs there, however
+  // far it is from where orientation starts (triangle 0).
+  const int segments = 40;
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < segments; ++i) {
+    const double angle = 2 * M_PI * i / segments;
+    for (double radius : {0.8, 1.2})
+      points.emplace_back(radius * std::cos(angle), radius * std::sin(angle), 0.0);
+  }
+  std::vector<Triangle> band;
+  for (int i = 0; i < segments; ++i) {
+    const VertexIndex a = 2 * i, b = 2 * i + 1;
+    VertexIndex c = 2 * ((i + 1) % segments), d = c + 1;
+    if (i == segments - 1)
+      std::swap(c, d);
+    band.push_back({a, b, d});
+    band.push_back({a, d, c});
+  }
+  std::vector<std::uint32_t> component;
+  std::vector<bool> orientable;
+  orientComponents(band, points, component, orientable);
+  ASSERT_EQ(orientable, std::vector<bool>{false});
+  auto runsFromTo = [](const Triangle &t, VertexIndex from, VertexIndex to) {
+    for (int k = 0; k < 3; ++k)
+      if (t[k] == from && t[(k + 1) % 3] == to)
+        return true;
+    return false;
+  };
+  const std::size_t crossed_quad = 2 * (segments - 1);
+  std::size_t inconsistent_edges = 0;
+  for (std::size_t t = 0; t < band.size(); ++t)
+    for (std::size_t u = t + 1; u < band.size(); ++u)
+      for (int k = 0; k < 3; ++k)
+        if (runsFromTo(band[u], band[t][k], band[t][(k + 1) % 3])) {
+          ++inconsistent_edges; // both run the shared edge the same way
+          EXPECT_TRUE(t >= crossed_quad || u >= crossed_quad)
+              << "inconsistent edge between triangles " << t << " and " << u;
+        }
+  EXPECT_EQ(inconsistent_edges, 1u);
+}
+
 TEST(Finish, MoebiusStripIsReportedNonOrientable) {
   std::vector<Eigen::Vector3d> points;
   std::vector<Triangle> strip;
