@@ -2,7 +2,8 @@
 //
 // Large clouds (issue #4): uniform samplings of a real mesh with 1M, 3M and
 // 10M points, meshed in one piece and in buckets with 1 and 2 threads,
-// beside CGAL's advancing front where it fits. Each run is a forked child,
+// beside CGAL's advancing front where it fits and, as a floor, CGAL's bare
+// 3-D Delaunay triangulation of the same points. Each run is a forked child,
 // so its peak memory is its own; the sampled cloud (held by the parent) is
 // part of every child's resident memory, as it would be in a user's process.
 // Time ratios are against the advancing front measured in the same run.
@@ -15,6 +16,8 @@
 #include <pcl_ms/mesh_quality.h>
 #include <pcl_ms/reconstruct.h>
 
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 
@@ -29,10 +32,13 @@ namespace {
 
 using pcl::console::print_error;
 using pcl::console::print_info;
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+
+enum class Runner { afsr, delaunay, pcl_ms };
 
 struct Configuration {
   std::string label;
-  bool afsr = false;
+  Runner runner = Runner::pcl_ms;
   std::size_t bucket_points = 0; // pcl_ms: 0 automatic, else the bucket size
   int threads = 1;
 };
@@ -61,7 +67,19 @@ Outcome run(const Configuration &configuration, const pcl::PointCloud<pcl::Point
     std::vector<pcl_ms::Triangle> triangles;
     double seconds = 0;
     std::size_t buckets = 0;
-    if (configuration.afsr) {
+    if (configuration.runner == Runner::delaunay) {
+      // Every Delaunay-based method pays for this; converting the points is
+      // input preparation and not timed, as for the advancing front.
+      std::vector<Kernel::Point_3> points;
+      points.reserve(cloud.size());
+      for (const pcl::PointXYZ &p : cloud)
+        points.emplace_back(p.x, p.y, p.z);
+      const auto start = std::chrono::steady_clock::now();
+      const CGAL::Delaunay_triangulation_3<Kernel> triangulation(points.begin(), points.end());
+      seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (triangulation.number_of_vertices() != points.size())
+        throw std::runtime_error("the triangulation lost points");
+    } else if (configuration.runner == Runner::afsr) {
       const pcl_ms_tools::PeerRun peer =
           pcl_ms_tools::runPeer(pcl_ms_tools::Method::afsr, cloud, pcl_ms_tools::PeerSettings());
       if (!peer.ok)
@@ -179,12 +197,14 @@ int main(int argc, char **argv) {
 
     const std::size_t bucket_size = static_cast<std::size_t>(bucket_points);
     std::vector<Configuration> configurations;
-    if (size <= afsr_up_to)
-      configurations.push_back({"CGAL advancing front", true, 0, 1});
+    if (size <= afsr_up_to) {
+      configurations.push_back({"CGAL advancing front", Runner::afsr, 0, 1});
+      configurations.push_back({"CGAL Delaunay only, 1 thread", Runner::delaunay, 0, 1});
+    }
     if (size <= one_piece_up_to)
-      configurations.push_back({"pcl_ms one piece, 1 thread", false, size, 1});
-    configurations.push_back({"pcl_ms buckets, 1 thread", false, bucket_size, 1});
-    configurations.push_back({"pcl_ms buckets, 2 threads", false, bucket_size, 2});
+      configurations.push_back({"pcl_ms one piece, 1 thread", Runner::pcl_ms, size, 1});
+    configurations.push_back({"pcl_ms buckets, 1 thread", Runner::pcl_ms, bucket_size, 1});
+    configurations.push_back({"pcl_ms buckets, 2 threads", Runner::pcl_ms, bucket_size, 2});
 
     // Rounds interleave the methods, so a slow spell of the machine hits
     // them alike; each keeps its fastest successful run.
@@ -206,20 +226,28 @@ int main(int argc, char **argv) {
         print_info("  %-28s failed: %s\n", configuration.label.c_str(), outcome.error.c_str());
         continue;
       }
-      if (configuration.afsr)
+      if (configuration.runner == Runner::afsr)
         afsr_seconds = outcome.seconds;
       const double ratio = afsr_seconds > 0 ? outcome.seconds / afsr_seconds : 0;
       char ratio_text[32] = "-";
       if (ratio > 0)
         std::snprintf(ratio_text, sizeof(ratio_text), "%.2fx", ratio);
-      print_info("  %-28s %9.2f %8s %9.0f %11zu %6zu %4zu / %-3zu %6zu %7zu\n",
-                 configuration.label.c_str(), outcome.seconds, ratio_text, outcome.peak_mb,
-                 outcome.triangles, outcome.boundary_loops, outcome.non_manifold_edges,
-                 outcome.non_manifold_vertices, outcome.components, outcome.buckets);
-      if (csv.is_open())
-        csv << size << ",\"" << configuration.label << "\"," << outcome.seconds << ','
-            << (ratio > 0 ? std::to_string(ratio) : "") << ',' << outcome.peak_mb << ','
-            << outcome.triangles << ',' << outcome.boundary_loops << ','
+      if (configuration.runner == Runner::delaunay) // no surface to count
+        print_info("  %-28s %9.2f %8s %9.0f %11s %6s %9s %6s %7s\n", configuration.label.c_str(),
+                   outcome.seconds, ratio_text, outcome.peak_mb, "-", "-", "-", "-", "-");
+      else
+        print_info("  %-28s %9.2f %8s %9.0f %11zu %6zu %4zu / %-3zu %6zu %7zu\n",
+                   configuration.label.c_str(), outcome.seconds, ratio_text, outcome.peak_mb,
+                   outcome.triangles, outcome.boundary_loops, outcome.non_manifold_edges,
+                   outcome.non_manifold_vertices, outcome.components, outcome.buckets);
+      if (!csv.is_open())
+        continue;
+      csv << size << ",\"" << configuration.label << "\"," << outcome.seconds << ','
+          << (ratio > 0 ? std::to_string(ratio) : "") << ',' << outcome.peak_mb;
+      if (configuration.runner == Runner::delaunay)
+        csv << ",,,,,,\n";
+      else
+        csv << ',' << outcome.triangles << ',' << outcome.boundary_loops << ','
             << outcome.non_manifold_edges << ',' << outcome.non_manifold_vertices << ','
             << outcome.components << ',' << outcome.buckets << '\n';
     }
