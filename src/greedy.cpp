@@ -6,23 +6,45 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace pcl_ms {
 namespace {
 
 enum class State : std::uint8_t { idle, queue1, queue2, accepted, dropped };
 
-struct QueueEntry {
-  float cost;
-  CandidateIndex candidate;
+/// A queued cost and its candidate packed into one integer that orders them
+/// cheapest first, ties by candidate index: the cost's bits form the high
+/// word, and costs are never negative (freshCost clamps at +0, NaN included),
+/// so their IEEE bit patterns sort like the values. One integer comparison
+/// per heap step instead of two float tests and a tie-break.
+class QueueEntry {
+public:
+  QueueEntry(float cost, CandidateIndex candidate)
+      : key_(std::uint64_t{bitsOf(cost)} << 32 | candidate) {}
+  float cost() const {
+    const auto bits = static_cast<std::uint32_t>(key_ >> 32);
+    float cost;
+    std::memcpy(&cost, &bits, sizeof cost);
+    return cost;
+  }
+  CandidateIndex candidate() const { return static_cast<CandidateIndex>(key_); }
+  // Boost's heaps keep the greatest element on top: "greater" puts the
+  // cheapest first.
+  bool operator>(const QueueEntry &other) const { return key_ > other.key_; }
+
+private:
+  static std::uint32_t bitsOf(float cost) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &cost, sizeof bits);
+    return bits;
+  }
+
+  std::uint64_t key_;
 };
 
-// Boost's heaps keep the greatest element on top: "greater" puts the
-// cheapest first, and the candidate index breaks ties so the order is total.
 struct CheaperFirst {
-  bool operator()(const QueueEntry &a, const QueueEntry &b) const {
-    return a.cost > b.cost || (a.cost == b.cost && a.candidate > b.candidate);
-  }
+  bool operator()(const QueueEntry &a, const QueueEntry &b) const { return a > b; }
 };
 
 /// Boost's contiguous d-ary heap without handles: a candidate whose cost
@@ -212,14 +234,14 @@ private:
   int queueNumber(State state) const { return state == State::queue1 ? 0 : 1; }
 
   bool isCurrent(const QueueEntry &entry, State queue) const {
-    const CandidateState &state = states_[entry.candidate];
-    return state.state == queue && state.cost == entry.cost;
+    const CandidateState &state = states_[entry.candidate()];
+    return state.state == queue && state.cost == entry.cost();
   }
 
   /// Puts t's current cost on the heap of `queue` (its state already).
   void enqueue(CandidateIndex t, State queue) {
     CandidateQueue &heap = queues_[queueNumber(queue)];
-    heap.push(QueueEntry{states_[t].cost, t});
+    heap.push(QueueEntry(states_[t].cost, t));
     if (heap.size() > 2 * queued_[queueNumber(queue)] + compaction_slack)
       heap.compact([&](const QueueEntry &entry) { return isCurrent(entry, queue); });
   }
@@ -260,7 +282,7 @@ private:
       queue.pop();
       if (!isCurrent(entry, queue_state))
         continue;
-      const CandidateIndex t = entry.candidate;
+      const CandidateIndex t = entry.candidate();
       --queued_[queueNumber(queue_state)];
       states_[t].state = State::idle;
       ++statistics.popped;
@@ -407,11 +429,11 @@ private:
     }
     if (inner_triangles < 3)
       return;
-    const auto fans = mesh_.fansAround(v);
-    if (fans.size() <= 1) {
+    if (mesh_.isSingleFan(v)) {
       multi_fan_vertex_[v] = false;
       return;
     }
+    const auto fans = mesh_.fansAround(v);
     const std::vector<CandidateIndex> *closed = nullptr;
     for (const auto &fan : fans)
       if (isClosedFan(fan, v))
@@ -601,9 +623,9 @@ private:
       const VertexIndex v = pending.back();
       pending.pop_back();
       is_pending[v] = false;
-      const auto fans = mesh_.fansAround(v);
-      if (fans.size() <= 1)
+      if (mesh_.isSingleFan(v))
         continue;
+      const auto fans = mesh_.fansAround(v);
       std::size_t best = 0;
       for (std::size_t f = 1; f < fans.size(); ++f) {
         const std::size_t fixed = fixedCount(fans[f]), best_fixed = fixedCount(fans[best]);

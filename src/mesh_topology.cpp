@@ -76,4 +76,30 @@ std::vector<std::vector<CandidateIndex>> MeshTopology::fansAround(VertexIndex v)
   return fans;
 }
 
+bool MeshTopology::isSingleFan(VertexIndex v) const {
+  const VertexTriangles &around = vertex_triangles_[v];
+  if (around.size() <= 1)
+    return true;
+  // With at most two triangles per edge, the triangles at v chained through
+  // their edges at v form paths and cycles: walk both ways from the first.
+  const CandidateIndex start = around[0];
+  std::size_t reached = 1;
+  for (EdgeIndex first_edge : edgesAt(start, v)) {
+    CandidateIndex current = start;
+    EdgeIndex through = first_edge;
+    for (;;) {
+      const CandidateIndex next = otherTriangle(through, current);
+      if (next == no_candidate)
+        break;
+      if (next == start) // a closed fan: walking the other way finds nothing new
+        return reached == around.size();
+      ++reached;
+      const auto edges = edgesAt(next, v);
+      through = edges[0] == through ? edges[1] : edges[0];
+      current = next;
+    }
+  }
+  return reached == around.size();
+}
+
 } // namespace pcl_ms

@@ -11,6 +11,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <map>
 #include <set>
 
 using namespace pcl_ms;
@@ -209,6 +210,54 @@ TEST(MeshTopology, CountsFollowAddAndRemove) {
   EXPECT_FALSE(mesh.contains(3));
   for (VertexIndex v : scaffold.candidates[3].vertices)
     EXPECT_FALSE(mesh.isClosedVertex(v));
+}
+
+namespace {
+
+/// A scaffold holding just the given triangles as candidates, edges numbered
+/// by hand (MeshTopology needs nothing else).
+MedialScaffold scaffoldOfTriangles(const std::vector<Triangle> &triangles) {
+  MedialScaffold scaffold;
+  std::map<std::pair<VertexIndex, VertexIndex>, EdgeIndex> edge_ids;
+  for (Triangle vertices : triangles) {
+    std::sort(vertices.begin(), vertices.end());
+    Candidate candidate{};
+    candidate.vertices = vertices;
+    for (int k = 0; k < 3; ++k) {
+      const auto key = std::minmax(vertices[k], vertices[(k + 1) % 3]);
+      candidate.edges[k] =
+          edge_ids.emplace(key, static_cast<EdgeIndex>(edge_ids.size())).first->second;
+    }
+    scaffold.candidates.push_back(candidate);
+  }
+  scaffold.edge_offsets.assign(edge_ids.size() + 1, 0);
+  return scaffold;
+}
+
+} // namespace
+
+TEST(MeshTopology, SingleFanTestAgreesWithTheFans) {
+  // Vertex 0 is the centre of a closed ring of six triangles and of a
+  // separate open fan of two: every subset of them is tried.
+  std::vector<Triangle> triangles;
+  for (VertexIndex i = 1; i <= 6; ++i)
+    triangles.push_back({0, i, i % 6 + 1});
+  triangles.push_back({0, 7, 8});
+  triangles.push_back({0, 8, 9});
+  const MedialScaffold scaffold = scaffoldOfTriangles(triangles);
+  int several_fans = 0;
+  for (unsigned subset = 0; subset < (1u << triangles.size()); ++subset) {
+    MeshTopology mesh(scaffold, 10);
+    for (CandidateIndex t = 0; t < triangles.size(); ++t)
+      if (subset & (1u << t))
+        mesh.add(t);
+    for (VertexIndex v = 0; v < 10; ++v)
+      ASSERT_EQ(mesh.isSingleFan(v), mesh.fansAround(v).size() <= 1)
+          << "vertex " << v << ", subset " << subset;
+    several_fans += !mesh.isSingleFan(0);
+  }
+  // Sanity check of the enumeration: bow-ties at the centre are common.
+  EXPECT_GT(several_fans, 100);
 }
 
 // ---- greedy ------------------------------------------------------------------------

@@ -82,6 +82,9 @@ public:
   /// The triangles at v grouped into fans (connected through edges at v),
   /// each fan in ascending triangle order, fans ordered by first triangle.
   std::vector<std::vector<CandidateIndex>> fansAround(VertexIndex v) const;
+  /// Whether v's triangles (if any) form one fan: fansAround(v).size() <= 1,
+  /// found by walking the fan without building it.
+  bool isSingleFan(VertexIndex v) const;
 
   /// The two edges of candidate t that contain vertex v.
   std::array<EdgeIndex, 2> edgesAt(CandidateIndex t, VertexIndex v) const;
