@@ -553,7 +553,7 @@ BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters) {
     options.d_med = task.d_med;
     options.fixed_triangles = task.fixed_triangles.empty() ? nullptr : &task.fixed_triangles;
     options.frozen_vertices = task.frozen.empty() ? nullptr : &task.frozen;
-    const MedialScaffold scaffold = buildMedialScaffold(task.points, options);
+    MedialScaffold scaffold = buildMedialScaffold(task.points, options);
     outcome.d_med = scaffold.d_med;
     outcome.delaunay_seconds = scaffold.delaunay_seconds;
     outcome.scaffold_seconds = secondsSince(start) - scaffold.delaunay_seconds;

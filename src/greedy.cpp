@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <numeric>
+#include <unordered_map>
 
 namespace pcl_ms {
 namespace {
@@ -96,12 +98,13 @@ constexpr double smooth_bending_angle = 0.35;
 
 class GreedyMesher::Impl {
 public:
-  Impl(const MedialScaffold &scaffold, const std::vector<Eigen::Vector3d> &points,
+  Impl(MedialScaffold &scaffold, const std::vector<Eigen::Vector3d> &points,
        const Parameters &parameters, GreedyStatistics &statistics)
       : scaffold_(scaffold), candidates_(scaffold.candidates), points_(points),
         parameters_(parameters), statistics_(statistics), mesh_(scaffold, points.size()),
         states_(candidates_.size()), is_fixed_(candidates_.size(), false),
-        multi_fan_vertex_(points.size(), false), may_have_several_fans_(points.size(), false) {
+        multi_fan_vertex_(points.size(), false), may_have_several_fans_(points.size(), false),
+        edge_count_(scaffold.numberOfEdges()) {
     for (CandidateIndex t : scaffold.fixed)
       is_fixed_[t] = true;
     delay_multiplier_.resize(2 * static_cast<std::size_t>(parameters.max_delays) + 1);
@@ -182,21 +185,16 @@ private:
   /// current cost is what error recovery compares against.
   void propagateContext(CandidateIndex t, double sign) {
     const Candidate &candidate = candidates_[t];
-    for (int k = 0; k < 3; ++k) {
-      const EdgeIndex e = candidate.edges[k];
-      // Type III candidates all wait for Q2 during pass 1 (fixed ones are
-      // listed in the first group).
-      const CandidateIndex *end =
-          queue2_built_ ? scaffold_.edgeEnd(e) : scaffold_.edgeAmbiguousBegin(e);
-      for (const CandidateIndex *s = scaffold_.edgeBegin(e); s != end; ++s) {
+    for (int k = 0; k < 3; ++k)
+      forEachCandidateOn(candidate.edges[k], [&](CandidateIndex s) {
         // Dropped candidates never return; waiting Q2 members get their
         // context recomputed when Q2 is built.
-        if (*s == t || states_[*s].state == State::dropped || isWaitingForQueue2(*s))
-          continue;
-        states_[*s].context += sign * contextTerm(t, k, *s);
-        refreshCost(*s);
-      }
-    }
+        if (s == t || states_[s].state == State::dropped || isWaitingForQueue2(s))
+          return false;
+        states_[s].context += sign * contextTerm(t, k, s);
+        refreshCost(s);
+        return false;
+      });
   }
 
   /// Context of t from scratch: the sum over accepted triangles on its edges.
@@ -259,7 +257,7 @@ private:
   /// The closed-vertex rule is applied now rather than at each pop: after
   /// pass 1 most type III candidates touch a closed vertex.
   void buildQueue2(PassStatistics &statistics) {
-    queue2_built_ = true;
+    std::vector<CandidateIndex> members;
     for (CandidateIndex t = 0; t < candidates_.size(); ++t) {
       if (states_[t].state != State::queue2)
         continue;
@@ -268,11 +266,93 @@ private:
         ++statistics.rejected;
         continue;
       }
+      members.push_back(t);
+    }
+    listLateCandidates(members);
+    queue2_built_ = true;
+    for (CandidateIndex t : members) {
       states_[t].context = contextFromScratch(t);
       states_[t].cost = static_cast<float>(freshCost(t));
       ++queued_[1];
       enqueue(t, State::queue2);
     }
+  }
+
+  // ---- edges of type III candidates --------------------------------------
+
+  /// Visits the candidates on edge e, in ascending order within each group:
+  /// the scaffold's (types I and II, fixed), the type III ones that reached
+  /// pass 2, then any that a diagonal swap brought in. Stops when visit
+  /// returns true, and says whether it did.
+  template <typename Visit> bool forEachCandidateOn(EdgeIndex e, const Visit &visit) const {
+    if (e < scaffold_.numberOfEdges())
+      for (const CandidateIndex *s = scaffold_.edgeBegin(e); s != scaffold_.edgeEnd(e); ++s)
+        if (visit(*s))
+          return true;
+    if (e + std::size_t{1} < late_offsets_.size())
+      for (std::uint32_t i = late_offsets_[e]; i < late_offsets_[e + 1]; ++i)
+        if (visit(late_candidates_[i]))
+          return true;
+    if (!swapped_in_.empty()) {
+      const auto found = swapped_in_.find(e);
+      if (found != swapped_in_.end())
+        for (CandidateIndex s : found->second)
+          if (visit(s))
+            return true;
+    }
+    return false;
+  }
+
+  bool hasEdges(CandidateIndex t) const { return candidates_[t].edges[0] != no_edge; }
+
+  /// The edge joining a and b: the scaffold's, one numbered here, or no_edge.
+  EdgeIndex findEdge(VertexIndex a, VertexIndex b) const {
+    const EdgeIndex e = scaffold_.findEdge(a, b);
+    if (e != no_edge || new_edges_.empty())
+      return e;
+    const auto found = new_edges_.find(vertexPairKey(a, b));
+    return found == new_edges_.end() ? no_edge : found->second;
+  }
+
+  static std::uint64_t vertexPairKey(VertexIndex a, VertexIndex b) {
+    return a < b ? std::uint64_t{a} << 32 | b : std::uint64_t{b} << 32 | a;
+  }
+
+  /// Gives a type III candidate the ids of its edges, numbering the edges
+  /// that no pass-1 candidate has.
+  void numberEdges(CandidateIndex t) {
+    Candidate &candidate = candidates_[t];
+    for (int k = 0; k < 3; ++k) {
+      const VertexIndex a = candidate.vertices[k], b = candidate.vertices[(k + 1) % 3];
+      EdgeIndex e = findEdge(a, b);
+      if (e == no_edge) {
+        e = static_cast<EdgeIndex>(edge_count_++);
+        new_edges_.emplace(vertexPairKey(a, b), e);
+      }
+      candidate.edges[k] = e;
+    }
+    mesh_.growEdges(edge_count_);
+  }
+
+  /// Numbers the edges of the type III members of Q2 and lists them per
+  /// edge, as the scaffold lists the pass-1 candidates.
+  void listLateCandidates(const std::vector<CandidateIndex> &members) {
+    std::vector<CandidateIndex> late;
+    for (CandidateIndex t : members)
+      if (!hasEdges(t)) {
+        numberEdges(t);
+        late.push_back(t);
+      }
+    late_offsets_.assign(edge_count_ + 1, 0);
+    for (CandidateIndex t : late)
+      for (EdgeIndex e : candidates_[t].edges)
+        ++late_offsets_[e + 1];
+    std::partial_sum(late_offsets_.begin(), late_offsets_.end(), late_offsets_.begin());
+    late_candidates_.resize(late_offsets_.back());
+    std::vector<std::uint32_t> cursor(late_offsets_.begin(), late_offsets_.end() - 1);
+    for (CandidateIndex t : late)
+      for (EdgeIndex e : candidates_[t].edges)
+        late_candidates_[cursor[e]++] = t;
   }
 
   void runPass(State queue_state, PassStatistics &statistics) {
@@ -382,20 +462,18 @@ private:
     for (EdgeIndex e : candidates_[t].edges) {
       if (mesh_.edgeTriangleCount(e) != 1)
         continue;
-      // Type III candidates are never in Q1.
-      const CandidateIndex *end =
-          queue == State::queue1 ? scaffold_.edgeAmbiguousBegin(e) : scaffold_.edgeEnd(e);
-      for (const CandidateIndex *s = scaffold_.edgeBegin(e); s != end; ++s) {
-        if (*s == t || states_[*s].state != queue ||
-            states_[*s].ranking_delays >= parameters_.max_delays)
-          continue;
-        if (std::abs(states_[*s].cost - states_[t].cost) <= tolerance) {
-          ++states_[*s].ranking_delays;
-          refreshCost(*s);
-          ++states_[t].ranking_delays;
-          return true;
-        }
-      }
+      const bool delayed = forEachCandidateOn(e, [&](CandidateIndex s) {
+        if (s == t || states_[s].state != queue ||
+            states_[s].ranking_delays >= parameters_.max_delays ||
+            std::abs(states_[s].cost - states_[t].cost) > tolerance)
+          return false;
+        ++states_[s].ranking_delays;
+        refreshCost(s);
+        ++states_[t].ranking_delays;
+        return true;
+      });
+      if (delayed)
+        return true;
     }
     return false;
   }
@@ -490,14 +568,50 @@ private:
     return candidate.edges[0];
   }
 
-  /// The candidate on edge e whose third vertex is apex, or no_candidate.
-  CandidateIndex candidateWith(EdgeIndex e, VertexIndex apex) const {
-    for (const CandidateIndex *s = scaffold_.edgeBegin(e); s != scaffold_.edgeEnd(e); ++s) {
-      const auto &v = candidates_[*s].vertices;
+  /// The candidate (a, b, apex), where a and b are the ends of edge e, or
+  /// no_candidate: on e's lists, else among the type III candidates without
+  /// edges (unnumbered_, by lowest vertex). Vertex sets are unique, so where
+  /// it is found does not matter.
+  CandidateIndex candidateWith(EdgeIndex e, VertexIndex a, VertexIndex b, VertexIndex apex) const {
+    CandidateIndex found = no_candidate;
+    forEachCandidateOn(e, [&](CandidateIndex s) {
+      const auto &v = candidates_[s].vertices;
       if (v[0] == apex || v[1] == apex || v[2] == apex)
-        return *s;
-    }
+        found = s;
+      return found != no_candidate;
+    });
+    if (found != no_candidate || unnumbered_offsets_.empty())
+      return found;
+    Triangle vertices = {a, b, apex};
+    std::sort(vertices.begin(), vertices.end());
+    for (std::uint32_t i = unnumbered_offsets_[vertices[0]];
+         i < unnumbered_offsets_[vertices[0] + 1]; ++i)
+      if (candidates_[unnumbered_[i]].vertices == vertices)
+        return unnumbered_[i];
     return no_candidate;
+  }
+
+  /// Lists the type III candidates still without edges by lowest vertex.
+  void listUnnumberedCandidates() {
+    unnumbered_offsets_.assign(points_.size() + 1, 0);
+    for (CandidateIndex t = 0; t < candidates_.size(); ++t)
+      if (!hasEdges(t))
+        ++unnumbered_offsets_[candidates_[t].vertices[0] + 1];
+    std::partial_sum(unnumbered_offsets_.begin(), unnumbered_offsets_.end(),
+                     unnumbered_offsets_.begin());
+    unnumbered_.resize(unnumbered_offsets_.back());
+    std::vector<std::uint32_t> cursor(unnumbered_offsets_.begin(), unnumbered_offsets_.end() - 1);
+    for (CandidateIndex t = 0; t < candidates_.size(); ++t)
+      if (!hasEdges(t))
+        unnumbered_[cursor[candidates_[t].vertices[0]]++] = t;
+  }
+
+  /// Numbers the edges of a type III candidate that a swap brings into the
+  /// mesh (pass 2 had dropped it) and lists it on them.
+  void bringInBySwap(CandidateIndex t) {
+    numberEdges(t);
+    for (EdgeIndex e : candidates_[t].edges)
+      swapped_in_[e].push_back(t);
   }
 
   VertexIndex apexOf(CandidateIndex t, VertexIndex a, VertexIndex c) const {
@@ -527,9 +641,12 @@ private:
   /// ridges stay). On curved surfaces the 3-D empty-sphere test alone often
   /// picks the diagonal a surface triangulation would not.
   void swapNonDelaunayDiagonals() {
+    listUnnumberedCandidates();
     std::vector<EdgeIndex> work;
-    std::vector<bool> queued(scaffold_.numberOfEdges(), false);
+    std::vector<bool> queued(edge_count_, false);
     auto enqueue = [&](EdgeIndex e) {
+      if (e >= queued.size()) // numbered by a swap
+        queued.resize(edge_count_, false);
       if (!queued[e] && mesh_.edgeTriangleCount(e) == 2) {
         queued[e] = true;
         work.push_back(e);
@@ -559,12 +676,13 @@ private:
       const VertexIndex b = apexOf(first, a, c), d = apexOf(second, a, c);
       if (!oppositeAnglesExceedPi(b, d, a, c))
         continue;
-      const CandidateIndex abd = candidateWith(edgeBetween(first, a, b), d);
-      const CandidateIndex bcd = candidateWith(edgeBetween(first, b, c), d);
+      const CandidateIndex abd = candidateWith(edgeBetween(first, a, b), a, b, d);
+      const CandidateIndex bcd = candidateWith(edgeBetween(first, b, c), b, c, d);
       if (abd == no_candidate || bcd == no_candidate || states_[abd].state == State::accepted ||
           states_[bcd].state == State::accepted)
         continue;
-      if (mesh_.edgeTriangleCount(edgeBetween(abd, b, d)) != 0)
+      const EdgeIndex diagonal = findEdge(b, d);
+      if (diagonal != no_edge && mesh_.edgeTriangleCount(diagonal) != 0)
         continue;
       const double bending_before = bendingAngle(points_[a], points_[c], points_[b], points_[d]);
       const double bending_after = bendingAngle(points_[b], points_[d], points_[a], points_[c]);
@@ -574,6 +692,9 @@ private:
         removeFromMesh(old);
         states_[old].state = State::dropped;
       }
+      for (CandidateIndex replacement : {abd, bcd})
+        if (!hasEdges(replacement))
+          bringInBySwap(replacement);
       for (CandidateIndex replacement : {abd, bcd}) {
         if (isQueued(replacement)) // its heap entry is outdated from now on
           --queued_[queueNumber(states_[replacement].state)];
@@ -585,6 +706,8 @@ private:
       }
       ++statistics_.swapped_pairs;
     }
+    unnumbered_offsets_ = {};
+    unnumbered_ = {};
   }
 
   // ---- clean-up ------------------------------------------------------------
@@ -668,8 +791,8 @@ private:
     return total;
   }
 
-  const MedialScaffold &scaffold_;
-  const std::vector<Candidate> &candidates_;
+  MedialScaffold &scaffold_;
+  std::vector<Candidate> &candidates_;
   const std::vector<Eigen::Vector3d> &points_;
   const Parameters &parameters_;
   GreedyStatistics &statistics_;
@@ -688,13 +811,22 @@ private:
   std::vector<bool> multi_fan_vertex_;
   std::vector<bool> may_have_several_fans_;
   std::vector<double> delay_multiplier_;
+  // Edges numbered here (type III candidates): their count with the
+  // scaffold's, their ids by end points, and who is on them.
+  std::size_t edge_count_;
+  std::unordered_map<std::uint64_t, EdgeIndex> new_edges_;
+  std::vector<std::uint32_t> late_offsets_;
+  std::vector<CandidateIndex> late_candidates_;
+  std::unordered_map<EdgeIndex, std::vector<CandidateIndex>> swapped_in_;
+  std::vector<std::uint32_t> unnumbered_offsets_; // by lowest vertex, during swaps
+  std::vector<CandidateIndex> unnumbered_;
   CandidateQueue queues_[2];       // Q1, Q2
   std::size_t queued_[2] = {0, 0}; // candidates whose state is that queue
   bool queue2_built_ = false;
 };
 
-GreedyMesher::GreedyMesher(const MedialScaffold &scaffold,
-                           const std::vector<Eigen::Vector3d> &points, const Parameters &parameters)
+GreedyMesher::GreedyMesher(MedialScaffold &scaffold, const std::vector<Eigen::Vector3d> &points,
+                           const Parameters &parameters)
     : impl_(std::make_unique<Impl>(scaffold, points, parameters, statistics_)) {}
 
 GreedyMesher::~GreedyMesher() = default;

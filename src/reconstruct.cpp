@@ -289,7 +289,7 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
     options.normals = normals;
     options.normal_weight = parameters.normal_weight;
     options.fixed_triangles = fixed.empty() ? nullptr : &fixed;
-    const MedialScaffold scaffold = buildMedialScaffold(prepared.positions, options);
+    MedialScaffold scaffold = buildMedialScaffold(prepared.positions, options);
     result.timings.delaunay = scaffold.delaunay_seconds;
     result.timings.scaffold = secondsSince(stage) - scaffold.delaunay_seconds;
     result.planar = scaffold.planar;

@@ -441,14 +441,28 @@ private:
 
   static constexpr CandidateIndex no_fixed_candidate = std::numeric_limits<CandidateIndex>::max();
 
-  /// Numbers the candidates' edges and lists the candidates on each edge.
+  /// Numbers the edges of the candidates pass 1 looks at (types I and II,
+  /// fixed ones) and lists those candidates on each edge. The other type III
+  /// candidates keep no_edge: numbering and listing them would cost most of
+  /// this stage, and only a few reach pass 2.
   void buildEdgeGraph() {
     std::vector<Candidate> &candidates = scaffold_.candidates;
     const std::size_t n = points_.size();
+    std::vector<bool> in_graph(candidates.size());
+    for (CandidateIndex t = 0; t < candidates.size(); ++t)
+      in_graph[t] = candidates[t].type != CandidateType::ambiguous;
+    // Fixed triangles are in the mesh from the start, whatever their type.
+    for (CandidateIndex t : scaffold_.fixed)
+      in_graph[t] = true;
+    for (CandidateIndex t = 0; t < candidates.size(); ++t)
+      if (!in_graph[t])
+        candidates[t].edges = {no_edge, no_edge, no_edge};
     // Neighbours b > a of every vertex a, via counting sort then per-vertex dedup.
     std::vector<std::uint32_t> offsets(n + 1, 0);
     auto forEachEdge = [&](auto &&visit) {
       for (CandidateIndex t = 0; t < candidates.size(); ++t) {
+        if (!in_graph[t])
+          continue;
         const auto &v = candidates[t].vertices;
         visit(t, 0, v[0], v[1]);
         visit(t, 1, v[1], v[2]);
@@ -457,14 +471,16 @@ private:
     };
     forEachEdge([&](CandidateIndex, int, VertexIndex low, VertexIndex) { ++offsets[low + 1]; });
     std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-    std::vector<VertexIndex> neighbours(offsets[n]);
+    std::vector<VertexIndex> &neighbours = scaffold_.edge_high_vertices;
+    neighbours.assign(offsets[n], 0);
     {
       std::vector<std::uint32_t> cursor(offsets.begin(), offsets.end() - 1);
       forEachEdge([&](CandidateIndex, int, VertexIndex low, VertexIndex high) {
         neighbours[cursor[low]++] = high;
       });
     }
-    std::vector<std::uint32_t> unique_offsets(n + 1, 0);
+    std::vector<std::uint32_t> &unique_offsets = scaffold_.edge_vertex_offsets;
+    unique_offsets.assign(n + 1, 0);
     std::size_t write = 0;
     for (std::size_t a = 0; a < n; ++a) {
       auto begin = neighbours.begin() + offsets[a], end = neighbours.begin() + offsets[a + 1];
@@ -492,23 +508,13 @@ private:
     });
     std::partial_sum(scaffold_.edge_offsets.begin(), scaffold_.edge_offsets.end(),
                      scaffold_.edge_offsets.begin());
-    scaffold_.edge_candidates.resize(3 * candidates.size());
+    scaffold_.edge_candidates.resize(scaffold_.edge_offsets.back());
     std::vector<std::uint32_t> cursor(scaffold_.edge_offsets.begin(),
                                       scaffold_.edge_offsets.end() - 1);
-    // Fixed triangles are in the mesh during pass 1 whatever their type, so
-    // they join the first group.
-    std::vector<bool> is_fixed(candidates.size(), false);
-    for (CandidateIndex t : scaffold_.fixed)
-      is_fixed[t] = true;
-    auto fill = [&](bool ambiguous) {
-      for (CandidateIndex t = 0; t < candidates.size(); ++t)
-        if ((candidates[t].type == CandidateType::ambiguous && !is_fixed[t]) == ambiguous)
-          for (EdgeIndex e : candidates[t].edges)
-            scaffold_.edge_candidates[cursor[e]++] = t;
-    };
-    fill(false);
-    scaffold_.edge_ambiguous_offsets = cursor;
-    fill(true);
+    for (CandidateIndex t = 0; t < candidates.size(); ++t)
+      if (in_graph[t])
+        for (EdgeIndex e : candidates[t].edges)
+          scaffold_.edge_candidates[cursor[e]++] = t;
   }
 
   const std::vector<Eigen::Vector3d> &points_;

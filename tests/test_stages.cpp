@@ -131,6 +131,56 @@ TEST(Scaffold, RegularTetrahedronHasFourAcuteCandidates) {
     EXPECT_EQ(scaffold.edgeEnd(e) - scaffold.edgeBegin(e), 2);
 }
 
+TEST(Scaffold, EdgeGraphHoldsOnlyTheCandidatesOfPassOne) {
+  std::vector<Eigen::Vector3d> points = pcl_ms_test::bunnyReference().vertices;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d &p : points)
+    centre += p / static_cast<double>(points.size());
+  for (Eigen::Vector3d &p : points)
+    p -= centre;
+  MedialScaffold scaffold = buildMedialScaffold(points, {});
+  ASSERT_GT(scaffold.type3, 0u);
+  std::size_t in_graph = 0, edges_of_type_three_only = 0;
+  for (CandidateIndex t = 0; t < scaffold.candidates.size(); ++t) {
+    const Candidate &candidate = scaffold.candidates[t];
+    for (int k = 0; k < 3; ++k) {
+      const EdgeIndex e = candidate.edges[k];
+      const EdgeIndex found =
+          scaffold.findEdge(candidate.vertices[(k + 1) % 3], candidate.vertices[k]);
+      if (candidate.type == CandidateType::ambiguous) {
+        ASSERT_EQ(e, no_edge);
+        edges_of_type_three_only += found == no_edge;
+        continue;
+      }
+      ASSERT_EQ(e, found);
+      ASSERT_TRUE(std::binary_search(scaffold.edgeBegin(e), scaffold.edgeEnd(e), t));
+    }
+    in_graph += candidate.type != CandidateType::ambiguous;
+  }
+  EXPECT_EQ(scaffold.edge_candidates.size(), 3 * in_graph);
+  EXPECT_GT(edges_of_type_three_only, 0u);
+
+  // Pass 2 numbers the edges of the type III candidates it meshes, new
+  // edges included, and the mesh stays edge-manifold.
+  GreedyMesher mesher(scaffold, points, Parameters());
+  mesher.run();
+  std::set<Triangle> type_three;
+  for (const Candidate &candidate : scaffold.candidates)
+    if (candidate.type == CandidateType::ambiguous)
+      type_three.insert(candidate.vertices);
+  std::map<std::pair<VertexIndex, VertexIndex>, int> edge_uses;
+  std::size_t meshed_type_three = 0;
+  for (Triangle triangle : mesher.triangles()) {
+    std::sort(triangle.begin(), triangle.end());
+    meshed_type_three += type_three.count(triangle);
+    for (int k = 0; k < 3; ++k)
+      ++edge_uses[std::minmax(triangle[k], triangle[(k + 1) % 3])];
+  }
+  EXPECT_GT(meshed_type_three, 0u);
+  for (const auto &[edge, uses] : edge_uses)
+    ASSERT_LE(uses, 2) << edge.first << "-" << edge.second;
+}
+
 TEST(Scaffold, ObtuseGabrielTriangleIsTypeTwo) {
   const std::vector<Eigen::Vector3d> points = {{0, 0, 0}, {1, 0, 0}, {0.5, 0.2, 0}, {0.5, 0.1, 5}};
   const MedialScaffold scaffold = buildMedialScaffold(points, {});
@@ -263,7 +313,7 @@ TEST(MeshTopology, SingleFanTestAgreesWithTheFans) {
 // ---- greedy ------------------------------------------------------------------------
 
 TEST(Greedy, TetrahedronClosesIntoFourTriangles) {
-  const MedialScaffold scaffold = buildMedialScaffold(regularTetrahedron(), {});
+  MedialScaffold scaffold = buildMedialScaffold(regularTetrahedron(), {});
   const std::vector<Eigen::Vector3d> points = regularTetrahedron();
   Parameters parameters;
   GreedyMesher mesher(scaffold, points, parameters);

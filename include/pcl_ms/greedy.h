@@ -26,7 +26,9 @@ struct GreedyStatistics {
 
 class GreedyMesher {
 public:
-  GreedyMesher(const MedialScaffold &scaffold, const std::vector<Eigen::Vector3d> &points,
+  /// The scaffold must outlive the mesher. It is not const: the type III
+  /// candidates that reach pass 2 get their edges numbered in it.
+  GreedyMesher(MedialScaffold &scaffold, const std::vector<Eigen::Vector3d> &points,
                const Parameters &parameters);
   ~GreedyMesher();
   GreedyMesher(const GreedyMesher &) = delete;

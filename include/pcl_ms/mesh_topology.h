@@ -51,6 +51,11 @@ public:
   /// Adds an accepted triangle. Precondition: each of its edges has fewer
   /// than two triangles (the 2-manifold edge rule).
   void add(CandidateIndex t);
+  /// Makes room for edges numbered after construction (ids below edge_count).
+  void growEdges(std::size_t edge_count) {
+    if (edge_count > edge_slots_.size())
+      edge_slots_.resize(edge_count, {no_candidate, no_candidate});
+  }
   void remove(CandidateIndex t);
   bool contains(CandidateIndex t) const { return in_mesh_[t]; }
 

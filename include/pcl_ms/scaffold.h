@@ -8,8 +8,11 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
+#include <limits>
+#include <utility>
 #include <vector>
 
 namespace pcl_ms {
@@ -37,15 +40,23 @@ struct Candidate {
   CandidateType type;
 };
 
+/// The edge slot of a candidate whose edges are not numbered yet.
+constexpr EdgeIndex no_edge = std::numeric_limits<EdgeIndex>::max();
+
 /// Candidates below d_max, and which candidates share each edge (CSR).
 struct MedialScaffold {
   std::vector<Candidate> candidates;
+  /// The edge graph holds the candidates pass 1 looks at: types I and II and
+  /// the fixed ones, ascending on each edge. The other type III candidates,
+  /// the majority but rarely kept, wait outside it with edges no_edge:
+  /// GreedyMesher numbers those that reach pass 2.
   std::vector<std::uint32_t> edge_offsets; // edges + 1 entries
-  /// On each edge the type I and II candidates and the fixed ones come
-  /// first, then the other type III ones, each group ascending; this is where
-  /// the second group of each edge starts. Pass 1 never looks at it.
-  std::vector<std::uint32_t> edge_ambiguous_offsets; // one per edge
   std::vector<CandidateIndex> edge_candidates;
+  /// Edge ids by end points: edge_vertex_offsets[a] is the id of a's first
+  /// edge to a higher vertex; ids run on in ascending order of the other end,
+  /// which edge_high_vertices holds. One entry per point (+ 1), one per edge.
+  std::vector<std::uint32_t> edge_vertex_offsets;
+  std::vector<VertexIndex> edge_high_vertices;
   /// The candidates of ScaffoldOptions::fixed_triangles, in the same order.
   std::vector<CandidateIndex> fixed;
 
@@ -65,9 +76,17 @@ struct MedialScaffold {
   const CandidateIndex *edgeEnd(EdgeIndex e) const {
     return edge_candidates.data() + edge_offsets[e + 1];
   }
-  /// The first non-fixed type III candidate on edge e (edgeEnd(e) if none).
-  const CandidateIndex *edgeAmbiguousBegin(EdgeIndex e) const {
-    return edge_candidates.data() + edge_ambiguous_offsets[e];
+  /// The id of the edge joining a and b, or no_edge if it is not in the graph.
+  EdgeIndex findEdge(VertexIndex a, VertexIndex b) const {
+    if (a > b)
+      std::swap(a, b);
+    if (a + std::size_t{1} >= edge_vertex_offsets.size())
+      return no_edge;
+    const auto begin = edge_high_vertices.begin() + edge_vertex_offsets[a];
+    const auto end = edge_high_vertices.begin() + edge_vertex_offsets[a + 1];
+    const auto it = std::lower_bound(begin, end, b);
+    return it != end && *it == b ? static_cast<EdgeIndex>(it - edge_high_vertices.begin())
+                                 : no_edge;
   }
 };
 
