@@ -495,14 +495,10 @@ private:
     neighbours.shrink_to_fit();
     const std::size_t edge_count = write;
 
-    auto edgeId = [&](VertexIndex low, VertexIndex high) {
-      const auto begin = neighbours.begin() + unique_offsets[low];
-      const auto end = neighbours.begin() + unique_offsets[low + 1];
-      return static_cast<EdgeIndex>(std::lower_bound(begin, end, high) - neighbours.begin());
-    };
+    // The dictionary is complete now: every edge of the graph is found.
     scaffold_.edge_offsets.assign(edge_count + 1, 0);
     forEachEdge([&](CandidateIndex t, int k, VertexIndex low, VertexIndex high) {
-      const EdgeIndex e = edgeId(low, high);
+      const EdgeIndex e = scaffold_.findEdge(low, high);
       candidates[t].edges[k] = e;
       ++scaffold_.edge_offsets[e + 1];
     });
