@@ -103,8 +103,7 @@ public:
       : scaffold_(scaffold), candidates_(scaffold.candidates), points_(points),
         parameters_(parameters), statistics_(statistics), mesh_(scaffold, points.size()),
         states_(candidates_.size()), is_fixed_(candidates_.size(), false),
-        multi_fan_vertex_(points.size(), false), may_have_several_fans_(points.size(), false),
-        edge_count_(scaffold.numberOfEdges()) {
+        multi_fan_vertex_(points.size(), false), may_have_several_fans_(points.size(), false) {
     for (CandidateIndex t : scaffold.fixed)
       is_fixed_[t] = true;
     delay_multiplier_.resize(2 * static_cast<std::size_t>(parameters.max_delays) + 1);
@@ -305,6 +304,9 @@ private:
 
   bool hasEdges(CandidateIndex t) const { return candidates_[t].edges[0] != no_edge; }
 
+  /// The scaffold's edges and those numbered here, which follow them.
+  std::size_t edgeCount() const { return scaffold_.numberOfEdges() + new_edges_.size(); }
+
   /// The edge joining a and b: the scaffold's, one numbered here, or no_edge.
   EdgeIndex findEdge(VertexIndex a, VertexIndex b) const {
     const EdgeIndex e = scaffold_.findEdge(a, b);
@@ -326,12 +328,12 @@ private:
       const VertexIndex a = candidate.vertices[k], b = candidate.vertices[(k + 1) % 3];
       EdgeIndex e = findEdge(a, b);
       if (e == no_edge) {
-        e = static_cast<EdgeIndex>(edge_count_++);
+        e = static_cast<EdgeIndex>(edgeCount());
         new_edges_.emplace(vertexPairKey(a, b), e);
       }
       candidate.edges[k] = e;
     }
-    mesh_.growEdges(edge_count_);
+    mesh_.growEdges(edgeCount());
   }
 
   /// Numbers the edges of the type III members of Q2 and lists them per
@@ -343,7 +345,7 @@ private:
         numberEdges(t);
         late.push_back(t);
       }
-    late_offsets_.assign(edge_count_ + 1, 0);
+    late_offsets_.assign(edgeCount() + 1, 0);
     for (CandidateIndex t : late)
       for (EdgeIndex e : candidates_[t].edges)
         ++late_offsets_[e + 1];
@@ -643,10 +645,10 @@ private:
   void swapNonDelaunayDiagonals() {
     listUnnumberedCandidates();
     std::vector<EdgeIndex> work;
-    std::vector<bool> queued(edge_count_, false);
+    std::vector<bool> queued(edgeCount(), false);
     auto enqueue = [&](EdgeIndex e) {
       if (e >= queued.size()) // numbered by a swap
-        queued.resize(edge_count_, false);
+        queued.resize(edgeCount(), false);
       if (!queued[e] && mesh_.edgeTriangleCount(e) == 2) {
         queued[e] = true;
         work.push_back(e);
@@ -811,9 +813,8 @@ private:
   std::vector<bool> multi_fan_vertex_;
   std::vector<bool> may_have_several_fans_;
   std::vector<double> delay_multiplier_;
-  // Edges numbered here (type III candidates): their count with the
-  // scaffold's, their ids by end points, and who is on them.
-  std::size_t edge_count_;
+  // Edges numbered here (type III candidates): their ids by end points, and
+  // who is on them.
   std::unordered_map<std::uint64_t, EdgeIndex> new_edges_;
   std::vector<std::uint32_t> late_offsets_;
   std::vector<CandidateIndex> late_candidates_;
