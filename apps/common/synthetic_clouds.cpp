@@ -71,6 +71,21 @@ Eigen::Vector3d unitSpherePointAtHeight(double z, PortableRandom &random) {
   return {radius * std::cos(longitude), radius * std::sin(longitude), z};
 }
 
+/// The part z >= lowest_z of the unit sphere, density ∝ exp(log_density_per_z * z).
+pcl::PointCloud<pcl::PointXYZ> sphereZoneWithDensityGradient(std::size_t points, double lowest_z,
+                                                             double log_density_per_z,
+                                                             std::uint64_t seed) {
+  PortableRandom random(seed);
+  const double densest_z = log_density_per_z > 0 ? 1.0 : lowest_z;
+  // Archimedes: z uniform is area-uniform on the sphere.
+  return sampleByRejection(
+      points, random,
+      [&] {
+        return unitSpherePointAtHeight(lowest_z + (1.0 - lowest_z) * random.uniform(), random);
+      },
+      [&](const Eigen::Vector3d &p) { return std::exp(log_density_per_z * (p.z() - densest_z)); });
+}
+
 /// Share of the dense level at angle θ of the torus bands: 1 inside a dense
 /// band, 0 inside a sparse one, a smoothstep across each border.
 double denseBandLevel(double theta, int bands) {
@@ -109,13 +124,9 @@ float rayEntersBox(const Eigen::Vector3f &origin, const Eigen::Vector3f &directi
 
 SyntheticCloud sphereWithDensityGradient(std::size_t points, double ratio, std::uint64_t seed) {
   requireRatio(ratio);
-  PortableRandom random(seed);
-  const double log_ratio = std::log(ratio);
   SyntheticCloud result;
-  // Archimedes: z uniform in [-1, 1] is area-uniform on the sphere.
-  result.cloud = sampleByRejection(
-      points, random, [&] { return unitSpherePointAtHeight(2.0 * random.uniform() - 1.0, random); },
-      [&](const Eigen::Vector3d &p) { return std::exp(log_ratio * (p.z() - 1.0) / 2.0); });
+  // ratio^((z + 1) / 2) = sqrt(ratio) · exp(log(ratio) / 2 · z)
+  result.cloud = sphereZoneWithDensityGradient(points, -1.0, std::log(ratio) / 2.0, seed);
   result.name = "sphere_gradient_" + shortNumber(ratio);
   result.density_law = "unit sphere, density ∝ ratio^((z+1)/2), ratio " + shortNumber(ratio);
   result.truth = {1, 0, 2, true};
@@ -185,12 +196,9 @@ SyntheticCloud annulusWithDensityGradient(std::size_t points, double ratio, std:
 
 SyntheticCloud hemisphereWithDensityGradient(std::size_t points, double ratio, std::uint64_t seed) {
   requireRatio(ratio);
-  PortableRandom random(seed);
-  const double log_ratio = std::log(ratio);
   SyntheticCloud result;
-  result.cloud = sampleByRejection(
-      points, random, [&] { return unitSpherePointAtHeight(random.uniform(), random); },
-      [&](const Eigen::Vector3d &p) { return std::exp(-log_ratio * p.z()); });
+  // ratio^(1 - z) = ratio · exp(-log(ratio) · z)
+  result.cloud = sphereZoneWithDensityGradient(points, 0.0, -std::log(ratio), seed);
   result.name = "hemisphere_gradient_" + shortNumber(ratio);
   result.density_law = "unit hemisphere z >= 0, density ∝ ratio^(1-z), ratio " + shortNumber(ratio);
   result.truth = {1, 1, 1, true};
