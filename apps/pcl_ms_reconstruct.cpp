@@ -57,8 +57,8 @@ void printHelp(const char *program) {
   print_info("  output  mesh: .ply (binary), .vtk or .obj; its vertices are the input points, in\n"
              "          order, with colours and normals where the format can hold them\n\n");
   print_info("Options:\n");
-  print_info("  -rho X          no triangle side reaches X * d_med, d_med being the median\n"
-             "                  circumradius of the candidate triangles (default ");
+  print_info("  -rho X          no triangle side reaches X times the local scale, the typical\n"
+             "                  circumradius of the surface triangles where it lies (default ");
   print_value("%g", pcl_ms::Parameters().rho);
   print_info(")\n");
   print_info("  -fill_holes K   close boundary loops of at most K edges, 0 = off (default ");

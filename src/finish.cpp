@@ -26,6 +26,8 @@ using EdgeKey = std::uint64_t;
 // twist of a real Moebius band, which is kept and reported.
 constexpr double max_untwist_bending = M_PI / 2;
 constexpr int max_untwist_rounds = 3;
+// Holes of at most this many edges are filled without the size limit.
+constexpr std::size_t max_unlimited_loop_edges = 4;
 // Loops opened by removing a twisted fan are closed again up to this size.
 constexpr int max_untwist_loop_edges = 16;
 
@@ -120,7 +122,8 @@ bool runsFromTo(const Triangle &t, VertexIndex a, VertexIndex b) {
 /// Minimum-cost triangulation of one boundary loop, or nothing.
 std::vector<Triangle> triangulateLoop(const std::vector<VertexIndex> &loop,
                                       const std::vector<Eigen::Vector3d> &points,
-                                      const std::vector<EdgeKey> &mesh_edges, double max_side) {
+                                      const std::vector<EdgeKey> &mesh_edges,
+                                      const SideLimit &limit) {
   using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
   using VertexBase = CGAL::Triangulation_vertex_base_with_info_3<std::size_t, Kernel>;
   using DataStructure = CGAL::Triangulation_data_structure_3<VertexBase>;
@@ -168,10 +171,14 @@ std::vector<Triangle> triangulateLoop(const std::vector<VertexIndex> &loop,
           continue;
         const TriangleShape shape =
             triangleShape(points[loop[i]], points[loop[k]], points[loop[j]]);
-        // A triangular hole takes its one triangle whatever its size; larger
-        // loops keep the greedy's size limit, or fillings would reach across
+        // A hole of three or four edges takes its triangles whatever their
+        // size (a missing triangle or quad between the greedy's triangles,
+        // whose new sides are at most two of its edges long); larger loops
+        // keep the greedy's size limit, or fillings would reach across
         // concave spots.
-        if (shape.compactness <= 0 || (m > 3 && shape.longest_side >= max_side))
+        if (shape.compactness <= 0 ||
+            (m > max_unlimited_loop_edges &&
+             shape.longest_side >= limit.maxSide({loop[i], loop[k], loop[j]})))
           continue;
         const double cost =
             best[i][k] + best[k][j] + shape.perimeter / (shape.compactness * shape.compactness);
@@ -254,8 +261,8 @@ std::vector<std::vector<VertexIndex>> boundaryLoops(const EdgeUses &uses) {
 
 /// fillHoles() given the mesh's boundary loops.
 std::size_t fillLoops(std::vector<Triangle> &triangles, std::vector<std::vector<VertexIndex>> loops,
-                      const std::vector<Eigen::Vector3d> &points, int max_edges, double max_side,
-                      const std::vector<bool> *only_around) {
+                      const std::vector<Eigen::Vector3d> &points, int max_edges,
+                      const SideLimit &limit, const std::vector<bool> *only_around) {
   if (max_edges < 3)
     return 0;
   // Only simple loops: a vertex met twice is a pinch the polygon DP cannot
@@ -302,7 +309,7 @@ std::size_t fillLoops(std::vector<Triangle> &triangles, std::vector<std::vector<
   for (const auto &loop : loops) {
     if (loop.size() < 3 || loop.size() > static_cast<std::size_t>(max_edges))
       continue;
-    std::vector<Triangle> filling = triangulateLoop(loop, points, mesh_edges, max_side);
+    std::vector<Triangle> filling = triangulateLoop(loop, points, mesh_edges, limit);
     bool duplicates_existing = false;
     for (Triangle t : filling) {
       std::sort(t.begin(), t.end());
@@ -328,11 +335,10 @@ std::vector<std::vector<VertexIndex>> traceBoundaryLoops(const std::vector<Trian
 }
 
 std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen::Vector3d> &points,
-                      int max_edges, double max_side, const std::vector<bool> *only_around) {
+                      int max_edges, const SideLimit &limit, const std::vector<bool> *only_around) {
   if (max_edges < 3)
     return 0;
-  return fillLoops(triangles, traceBoundaryLoops(triangles), points, max_edges, max_side,
-                   only_around);
+  return fillLoops(triangles, traceBoundaryLoops(triangles), points, max_edges, limit, only_around);
 }
 
 namespace {
@@ -747,7 +753,7 @@ std::size_t removeTwistedFans(std::vector<Triangle> &triangles,
 
 FinishedSurface finishSurface(std::vector<Triangle> triangles,
                               const std::vector<Eigen::Vector3d> &points, int fill_holes_max_edges,
-                              double max_side, const std::vector<bool> *anchored_vertices) {
+                              const SideLimit &limit, const std::vector<bool> *anchored_vertices) {
   FinishedSurface surface;
   // Edge uses are built once per set of triangles. Orienting keeps the set,
   // so the boundary loops are traced before it and the uses freed: the
@@ -756,7 +762,7 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
     EdgeUses uses = edgeUses(triangles);
     surface.boundary_loops = boundaryLoops(uses);
     const std::size_t filled =
-        fillLoops(triangles, surface.boundary_loops, points, max_edges, max_side, only_around);
+        fillLoops(triangles, surface.boundary_loops, points, max_edges, limit, only_around);
     if (filled > 0) {
       uses = edgeUses(triangles);
       surface.boundary_loops = boundaryLoops(uses);

@@ -269,10 +269,12 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
       parameters.use_normals ? &prepared.normals : nullptr;
 
   std::vector<Triangle> triangles;
+  std::vector<float> local_scale; // per distinct point
   // Initial triangles are honoured by the one-piece path only.
   if (fixed.empty() && usesBuckets(prepared.positions.size(), parameters)) {
     BucketedSurface bucketed = meshInBuckets(prepared.positions, normals, parameters);
     triangles = std::move(bucketed.triangles);
+    local_scale = std::move(bucketed.local_scale);
     result.d_med = bucketed.d_med;
     result.d_max = parameters.rho * bucketed.d_med;
     result.bucket_statistics = bucketed.statistics;
@@ -305,6 +307,7 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
     GreedyMesher mesher(scaffold, prepared.positions, parameters);
     mesher.run();
     triangles = mesher.triangles();
+    local_scale = std::move(scaffold.local_scale);
     result.pass1 = mesher.statistics().pass1;
     result.pass2 = mesher.statistics().pass2;
     result.cleanup_undone = mesher.statistics().cleanup_undone;
@@ -325,9 +328,9 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
   // The finish stage's parallel loops use the threads the user allowed.
   FinishedSurface surface;
   detail::threadArena(parameters.num_threads).execute([&] {
-    surface =
-        finishSurface(std::move(triangles), prepared.positions, parameters.fill_holes_max_edges,
-                      result.d_max, anchored.empty() ? nullptr : &anchored);
+    surface = finishSurface(
+        std::move(triangles), prepared.positions, parameters.fill_holes_max_edges,
+        SideLimit{&local_scale, parameters.rho}, anchored.empty() ? nullptr : &anchored);
   });
   // Back to the user's records.
   for (Triangle &triangle : surface.triangles)

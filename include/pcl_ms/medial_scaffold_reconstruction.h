@@ -47,9 +47,10 @@ public:
   void reconstruct(pcl::PointCloud<PointInT> &points,
                    std::vector<pcl::Vertices> &polygons) override;
 
-  /** \brief d_max = rho * d_med caps triangle sides, d_med being the median
-   * circumradius of the Gabriel Delaunay triangles (default 5; the paper uses
-   * 5-15, 30 closes the bunny's base holes). Must be > 0. */
+  /** \brief Triangle sides stay below rho times the local scale where the
+   * triangle lies: the typical circumradius of the surface triangles there,
+   * so sparse parts of a cloud get larger triangles than dense ones (default
+   * 5; the paper uses 5-15, 30 closes the bunny's base holes). Must be > 0. */
   void setRho(double rho) { parameters_.rho = rho; }
   double getRho() const { return parameters_.rho; }
 

@@ -29,9 +29,11 @@ struct PointView {
   const std::vector<int> *indices = nullptr;
 };
 
-/// All tuning knobs of the method; defaults follow ALGORITHM.md.
+/// All tuning knobs of the method (docs/algorithm.md).
 struct Parameters {
-  /// d_max = rho * d_med: candidates with a side >= d_max are never queued.
+  /// Candidates with a side >= rho times their local scale (the typical
+  /// circumradius of the surface triangles where they lie; on a uniform
+  /// sample about d_med) are never queued.
   /// 5, the low end of the paper's 5-15: on the Stanford bunny, 10 already
   /// bridges the two large base holes that the paper leaves open (1.5 % of
   /// the diagonal off the reference surface, against 0.5 % at 5, same recall).
@@ -132,6 +134,8 @@ struct Result {
 
   std::size_t candidates_type1 = 0, candidates_type2 = 0, candidates_type3 = 0;
   std::size_t candidates_oversize = 0;
+  /// Summaries: the median Gabriel circumradius and rho times it. The size
+  /// limit itself is local (Parameters::rho).
   double d_med = 0, d_max = 0;
   PassStatistics pass1, pass2;
   std::size_t cleanup_undone = 0; // flaps/isolated triangles and final sweep
