@@ -27,6 +27,10 @@ std::string Parameters::validate() const {
   else if (fill_holes_max_edges < 0 || fill_holes_max_edges == 1 || fill_holes_max_edges == 2)
     reason << "fill_holes must be 0 (off) or a number of edges >= 3 (got " << fill_holes_max_edges
            << ")";
+  else if (viewpoint && !(std::isfinite((*viewpoint)[0]) && std::isfinite((*viewpoint)[1]) &&
+                          std::isfinite((*viewpoint)[2])))
+    reason << "the viewpoint must be finite (got " << (*viewpoint)[0] << ", " << (*viewpoint)[1]
+           << ", " << (*viewpoint)[2] << ")";
   else if (!(std::isfinite(normal_weight) && normal_weight >= 0))
     reason << "normal weight must be >= 0 (got " << normal_weight << ")";
   else if (!(close_ranking_tolerance >= 0 && close_ranking_tolerance < 1))
@@ -77,6 +81,8 @@ struct PreparedPoints {
   std::vector<Eigen::Vector3d> positions;
   std::vector<Eigen::Vector3f> normals;
   std::vector<VertexIndex> user_index;
+  /// Subtracted from the user's coordinates.
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   /// For each user record, its distinct point (duplicates share one), or
   /// not_prepared for records left out (NaN/Inf, not in the indices). Only
   /// built when asked for: initial triangles need it.
@@ -161,6 +167,7 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
   if (map_records)
     prepared.prepared_of_record.assign(view.size, not_prepared);
   const Eigen::Vector3d centre = 0.5 * (low + high);
+  prepared.centre = centre;
   for (std::size_t i = 0; i < keys.size(); ++i) {
     const Key &key = keys[i];
     if (i > 0 && key.coordinates == keys[i - 1].coordinates) {
@@ -326,11 +333,17 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
         anchored[v] = true;
   }
   // The finish stage's parallel loops use the threads the user allowed.
+  std::optional<Eigen::Vector3d> viewpoint;
+  if (parameters.viewpoint)
+    viewpoint = Eigen::Vector3d((*parameters.viewpoint)[0], (*parameters.viewpoint)[1],
+                                (*parameters.viewpoint)[2]) -
+                prepared.centre;
   FinishedSurface surface;
   detail::threadArena(parameters.num_threads).execute([&] {
-    surface = finishSurface(
-        std::move(triangles), prepared.positions, parameters.fill_holes_max_edges,
-        SideLimit{&local_scale, parameters.rho}, anchored.empty() ? nullptr : &anchored);
+    surface =
+        finishSurface(std::move(triangles), prepared.positions, parameters.fill_holes_max_edges,
+                      SideLimit{&local_scale, parameters.rho},
+                      anchored.empty() ? nullptr : &anchored, viewpoint ? &*viewpoint : nullptr);
   });
   // Back to the user's records.
   for (Triangle &triangle : surface.triangles)

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,11 @@ struct Parameters {
   /// leaves a few tiny loops where its vertex rules refused the last
   /// triangle; 8 closes them on the bunny and leaves real openings alone.
   int fill_holes_max_edges = 8;
+  /// Where a one-view scan was taken from (the cloud's coordinates): every
+  /// component that has a boundary is then oriented to face it, and any
+  /// twist in it is repaired, since a surface seen from one point is never
+  /// one-sided. Closed components stay oriented outward.
+  std::optional<std::array<double, 3>> viewpoint;
   /// Use the input normals to prefer candidates aligned with them.
   bool use_normals = false;
   /// kappa in eps1 * (1 + kappa (1 - mean |n_T . n_v|)).
