@@ -28,7 +28,7 @@ constexpr double max_untwist_bending = M_PI / 2;
 constexpr int max_untwist_rounds = 3;
 // A twist that an orientation-reversing walk of at most this many triangles
 // closes is a crumple, repaired like a sharp fold.
-constexpr int max_local_twist_steps = 12;
+constexpr int max_local_twist_steps = 32;
 // Holes of at most this many edges are filled without the size limit.
 constexpr std::size_t max_unlimited_loop_edges = 4;
 // Loops opened by removing a twisted fan are closed again up to this size.
