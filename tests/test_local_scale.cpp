@@ -171,6 +171,37 @@ TEST(Viewpoint, ExplicitViewpointWinsAndIsValidated) {
   EXPECT_THROW(pcl_ms::reconstruct(viewOf(scan.cloud), parameters), pcl_ms::ReconstructionError);
 }
 
+TEST(Viewpoint, PclClassTakesTheSensorOriginUnlessToldNotTo) {
+  const auto scan = pcl_ms_tools::oneViewScanOfBoxOnPlane();
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>(scan.cloud);
+  pcl::MedialScaffoldReconstruction<pcl::PointXYZ> reconstruction;
+  reconstruction.setInputCloud(cloud);
+  float x, y, z;
+  EXPECT_FALSE(reconstruction.getViewpoint(x, y, z));
+  auto trianglesOf = [&] {
+    pcl::PolygonMesh mesh;
+    reconstruction.reconstruct(mesh);
+    return reconstruction.getResult().triangles;
+  };
+  pcl_ms::Parameters parameters;
+  const std::vector<Triangle> without =
+      pcl_ms::reconstruct(viewOf(scan.cloud), parameters).triangles;
+  const Eigen::Vector3f &sensor = scan.scene.sensor;
+  parameters.viewpoint = {{sensor.x(), sensor.y(), sensor.z()}};
+  const std::vector<Triangle> with = pcl_ms::reconstruct(viewOf(scan.cloud), parameters).triangles;
+  ASSERT_NE(with, without);
+  EXPECT_EQ(trianglesOf(), with); // organized: the sensor origin
+  reconstruction.setUseSensorOrigin(false);
+  EXPECT_EQ(trianglesOf(), without);
+  reconstruction.setViewpoint(sensor.x(), sensor.y(), sensor.z()); // explicit wins
+  ASSERT_TRUE(reconstruction.getViewpoint(x, y, z));
+  EXPECT_EQ(Eigen::Vector3f(x, y, z), sensor);
+  EXPECT_EQ(trianglesOf(), with);
+  reconstruction.clearViewpoint();
+  EXPECT_FALSE(reconstruction.getViewpoint(x, y, z));
+  EXPECT_EQ(trianglesOf(), without);
+}
+
 TEST(Viewpoint, ClosedSurfacesStayOutward) {
   // A viewpoint inside the sphere must not turn it inside out.
   const auto sphere = pcl_ms_tools::sphereWithDensityGradient();
