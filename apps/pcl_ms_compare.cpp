@@ -381,11 +381,16 @@ int run(int argc, char **argv) {
   const bool verbose = !options.quiet;
 
   pcl::PCLPointCloud2 blob;
+  Eigen::Vector4f sensor_origin;
   {
     SilencePclMessages silence;
-    if (!pcl_ms::loadPointCloud(options.input, blob, error))
+    if (!pcl_ms::loadPointCloud(options.input, blob, error, &sensor_origin))
       return fail(kIoFailure, error);
   }
+  // A depth frame's sensor is its viewpoint, as for the PCL class.
+  PeerSettings settings;
+  if (blob.height > 1 || sensor_origin.head<3>() != Eigen::Vector3f::Zero())
+    settings.viewpoint = {{sensor_origin[0], sensor_origin[1], sensor_origin[2]}};
   pcl::PointCloud<pcl::PointXYZ> points;
   const std::size_t skipped = finitePoints(blob, points);
   blob = pcl::PCLPointCloud2(); // only the positions are needed from here on
@@ -417,7 +422,6 @@ int run(int argc, char **argv) {
   // All methods run before anything multi-threaded happens in this process,
   // so every fork starts from a single-threaded parent.
   const double baseline_mb = runInChild([] { return std::string(); }).peak_mb;
-  const PeerSettings settings;
   std::vector<Entry> entries;
   const std::size_t total = options.methods.size();
   for (std::size_t i = 0; i < total; ++i) {

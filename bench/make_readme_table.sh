@@ -40,7 +40,8 @@ work=$build_dir/readme_table
 
 for file in data/bunny.pcd data/bun_zipper.ply "$shared/stanford_bunny/data/bun000.ply" \
   "$shared/cgal/meshes/fandisk.off" "$shared/libigl-tutorial-data/camelhead.off" \
-  "$shared/vcglib-trimeshinfo/moebius_big.ply" "$shared/pcl/milk.pcd"; do
+  "$shared/vcglib-trimeshinfo/moebius_big.ply" "$shared/pcl/milk.pcd" \
+  "$shared/pcl/table_scene_mug_stereo_textured.pcd"; do
   [[ -f $file ]] || fail "data file $file not found"
 done
 
@@ -53,6 +54,9 @@ python3 "$helper" mesh2ply "$shared/cgal/meshes/fandisk.off" "$work/inputs/fandi
 python3 "$helper" mesh2ply "$shared/libigl-tutorial-data/camelhead.off" "$work/inputs/camelhead.ply"
 python3 "$helper" mesh2ply "$shared/vcglib-trimeshinfo/moebius_big.ply" "$work/inputs/moebius.ply"
 python3 "$helper" sample "$work/inputs/moebius.ply" "$work/inputs/moebius_10k.xyz" 10000 1
+[[ -x $build_dir/make_synthetic_clouds ]] ||
+  fail "$build_dir/make_synthetic_clouds not found: build the project first"
+"$build_dir/make_synthetic_clouds" -out "$work/inputs/synthetic" >/dev/null
 
 printf 'id\tlabel\tinput\twhy\tgt\trecall\tstatus\n' >"$work/datasets.tsv"
 
@@ -94,6 +98,14 @@ run_set milk "Milk carton (noisy)" \
   "\`pcl/milk.pcd\`, a partial real scan of a milk carton from PCL's test data; no GT" \
   "A noisy real scan (visible depth noise and striping, one side only); topology only." \
   "$shared/pcl/milk.pcd" "" no
+run_set sphere_gradient "Sphere, density 1:25" \
+  "8,000 points on the unit sphere whose density falls 25-fold from one pole to the other (\`make_synthetic_clouds\`, fixed seed); no GT mesh" \
+  "Non-uniform sampling: one global length breaks the sparse half apart; the truth is one closed component with no boundary loop." \
+  "$work/inputs/synthetic/sphere_gradient_25.pcd" "" no
+run_set mug "Kinect frame (mug)" \
+  "\`pcl/table_scene_mug_stereo_textured.pcd\`, an organized 640 x 480 depth frame from PCL's test data (NaN where there is no depth); no GT" \
+  "What a robot's depth camera sees: density falling with range, depth jumps and noise; pcl_ms orients it towards the sensor, the frame's origin." \
+  "$shared/pcl/table_scene_mug_stereo_textured.pcd" "" no
 
 picture=docs/bunny_side_by_side.png
 if [[ -f $work/bunny/side_by_side.png ]]; then

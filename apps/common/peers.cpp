@@ -199,6 +199,7 @@ void runPclMs(const pcl::PointCloud<pcl::PointXYZ> &points, const PeerSettings &
   const pcl_ms::PointView view = pointView(points);
   pcl_ms::Parameters parameters; // the library's defaults
   parameters.num_threads = settings.threads;
+  parameters.viewpoint = settings.viewpoint;
   stages.start("reconstruction");
   pcl_ms::Result result = pcl_ms::reconstruct(view, parameters);
   stages.stop();
@@ -212,6 +213,10 @@ void runPclMs(const pcl::PointCloud<pcl::PointXYZ> &points, const PeerSettings &
   run.triangles = std::move(result.triangles);
   run.configuration = "defaults (rho " + formatNumber(parameters.rho) + ", fill holes up to " +
                       std::to_string(parameters.fill_holes_max_edges) + " edges), no normals";
+  if (parameters.viewpoint)
+    run.configuration += ", viewpoint " + formatNumber((*parameters.viewpoint)[0]) + "," +
+                         formatNumber((*parameters.viewpoint)[1]) + "," +
+                         formatNumber((*parameters.viewpoint)[2]) + " (the sensor origin)";
 }
 
 void runGp3(const pcl::PointCloud<pcl::PointXYZ> &points, const PeerSettings &settings,

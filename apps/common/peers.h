@@ -13,7 +13,9 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <array>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,6 +33,9 @@ std::string methodLabel(Method method);
 bool parseMethod(const std::string &text, Method &method);
 
 struct PeerSettings {
+  /// Where a one-view scan was taken from, for pcl_ms (Parameters::viewpoint):
+  /// pcl_ms_compare sets it to a depth frame's sensor origin.
+  std::optional<std::array<double, 3>> viewpoint;
   /// Neighbours for PCL's NormalEstimation (GP3, Poisson), as in PCL's
   /// tutorials, and for the minimum-spanning-tree orientation that follows.
   int normal_neighbours = 20;
