@@ -39,10 +39,12 @@ std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen:
 /// Orients every component consistently, spreading across the flattest
 /// shared edges first: outward for closed components (positive signed
 /// volume), towards the viewpoint (when given) for the others. A component
-/// where no consistent orientation exists is reported and kept. Returns one
-/// triangle per inconsistent edge that a repair should cut out: where the
-/// surface folds by more than 90 degrees, where the twist is local (a short
-/// orientation-reversing walk closes it), or anywhere with a viewpoint.
+/// where no consistent orientation exists is reported and kept. Returns the
+/// triangles where a repair should cut: first one per inconsistent edge that
+/// folds by more than 90 degrees (its most crumpled corner's fan goes), then
+/// both triangles of each other inconsistent edge whose twist is local (a
+/// short orientation-reversing walk closes it) or, with a viewpoint, of
+/// every other inconsistent edge.
 std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
                                             const std::vector<Eigen::Vector3d> &points,
                                             std::vector<std::uint32_t> &triangle_component,
