@@ -1,0 +1,229 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// ROS 1 nodelet pcl_ms/MedialScaffoldReconstructionNodelet: PointCloud2 in,
+// pcl_msgs/PolygonMesh and two RViz markers out. Everything but the message
+// plumbing lives in cloud_meshing.h, which knows nothing of ROS.
+#include "cloud_meshing.h"
+
+#include <nodelet/nodelet.h>
+#include <pcl_conversions/pcl_conversions.h>
+#include <pcl_msgs/PolygonMesh.h>
+#include <pluginlib/class_list_macros.hpp>
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <visualization_msgs/Marker.h>
+
+#include <atomic>
+#include <chrono>
+#include <mutex>
+
+namespace pcl_ms {
+
+class MedialScaffoldReconstructionNodelet : public nodelet::Nodelet {
+private:
+  using Clock = std::chrono::steady_clock;
+
+  void onInit() override;
+  void readParameters(ros::NodeHandle &private_node);
+  void cloudCallback(const sensor_msgs::PointCloud2ConstPtr &message);
+  void meshAndPublish(const sensor_msgs::PointCloud2 &message, Clock::time_point received);
+  void publishMarkers(const std_msgs::Header &header, const pcl::PCLPointCloud2 &cloud,
+                      const ros_bridge::MeshingOutcome &outcome);
+
+  ros_bridge::MeshingSettings settings_;
+  int queue_size_ = 1;
+  bool latch_ = false;
+  bool skip_if_busy_ = false;
+
+  ros::Subscriber cloud_subscriber_;
+  ros::Publisher mesh_publisher_;
+  ros::Publisher mesh_marker_publisher_;
+  ros::Publisher boundary_marker_publisher_;
+
+  std::atomic<bool> busy_{false};
+  std::atomic<std::size_t> dropped_clouds_{0};
+};
+
+namespace {
+
+double secondsBetween(std::chrono::steady_clock::time_point start,
+                      std::chrono::steady_clock::time_point end) {
+  return std::chrono::duration<double>(end - start).count();
+}
+
+void fillMarker(const ros_bridge::MarkerGeometry &geometry, visualization_msgs::Marker &marker) {
+  marker.points.resize(geometry.points.size());
+  for (std::size_t i = 0; i < geometry.points.size(); ++i) {
+    marker.points[i].x = geometry.points[i][0];
+    marker.points[i].y = geometry.points[i][1];
+    marker.points[i].z = geometry.points[i][2];
+  }
+  marker.colors.resize(geometry.colors.size());
+  for (std::size_t i = 0; i < geometry.colors.size(); ++i) {
+    marker.colors[i].r = geometry.colors[i][0];
+    marker.colors[i].g = geometry.colors[i][1];
+    marker.colors[i].b = geometry.colors[i][2];
+    marker.colors[i].a = geometry.colors[i][3];
+  }
+  // RViz refuses an ADD marker without points; DELETE clears the old one.
+  marker.action =
+      marker.points.empty() ? visualization_msgs::Marker::DELETE : visualization_msgs::Marker::ADD;
+}
+
+} // namespace
+
+void MedialScaffoldReconstructionNodelet::readParameters(ros::NodeHandle &private_node) {
+  private_node.param("rho", settings_.rho, settings_.rho);
+  private_node.param("fill_holes", settings_.fill_holes, settings_.fill_holes);
+  private_node.param("use_normals", settings_.use_normals, settings_.use_normals);
+  private_node.param("threads", settings_.threads, settings_.threads);
+  int bucket_points = 0;
+  private_node.param("bucket_points", bucket_points, 0);
+  if (bucket_points < 0) {
+    NODELET_ERROR("parameter bucket_points must be >= 0 (got %d): using 0 (automatic)",
+                  bucket_points);
+    bucket_points = 0;
+  }
+  settings_.bucket_points = static_cast<std::size_t>(bucket_points);
+  private_node.param("grid", settings_.grid, settings_.grid);
+  private_node.param("queue_size", queue_size_, queue_size_);
+  if (queue_size_ < 1) {
+    NODELET_ERROR("parameter queue_size must be >= 1 (got %d): using 1", queue_size_);
+    queue_size_ = 1;
+  }
+  private_node.param("latch", latch_, latch_);
+  private_node.param("skip_if_busy", skip_if_busy_, skip_if_busy_);
+}
+
+void MedialScaffoldReconstructionNodelet::onInit() {
+  ros::NodeHandle &node = getNodeHandle();
+  ros::NodeHandle &private_node = getPrivateNodeHandle();
+  readParameters(private_node);
+
+  const std::string settings_error = ros_bridge::checkSettings(settings_);
+  if (!settings_error.empty())
+    NODELET_ERROR("invalid parameters, every cloud will be refused until they are fixed: %s",
+                  settings_error.c_str());
+
+  mesh_publisher_ = node.advertise<pcl_msgs::PolygonMesh>("mesh", 1, latch_);
+  mesh_marker_publisher_ = node.advertise<visualization_msgs::Marker>("mesh_marker", 1, latch_);
+  boundary_marker_publisher_ =
+      node.advertise<visualization_msgs::Marker>("boundary_marker", 1, latch_);
+
+  // roscpp never runs one subscriber's callback twice at once, so a cloud
+  // arriving during meshing would wait in the queue. To drop it instead the
+  // callback must run concurrently (on the manager's multi-threaded queue)
+  // and return at once while another call is meshing.
+  ros::SubscribeOptions options;
+  options.init<sensor_msgs::PointCloud2>(
+      "input", static_cast<std::uint32_t>(queue_size_),
+      [this](const sensor_msgs::PointCloud2ConstPtr &message) { cloudCallback(message); });
+  options.allow_concurrent_callbacks = skip_if_busy_;
+  cloud_subscriber_ =
+      skip_if_busy_ ? getMTNodeHandle().subscribe(options) : node.subscribe(options);
+
+  NODELET_INFO("meshing clouds from %s into %s, %s and %s (rho %g, fill_holes %d, use_normals "
+               "%s, threads %d, bucket_points %zu, grid %d, queue_size %d, latch %s, "
+               "skip_if_busy %s)",
+               cloud_subscriber_.getTopic().c_str(), mesh_publisher_.getTopic().c_str(),
+               mesh_marker_publisher_.getTopic().c_str(),
+               boundary_marker_publisher_.getTopic().c_str(), settings_.rho, settings_.fill_holes,
+               settings_.use_normals ? "true" : "false", settings_.threads, settings_.bucket_points,
+               settings_.grid, queue_size_, latch_ ? "true" : "false",
+               skip_if_busy_ ? "true" : "false");
+}
+
+void MedialScaffoldReconstructionNodelet::cloudCallback(
+    const sensor_msgs::PointCloud2ConstPtr &message) {
+  const Clock::time_point received = Clock::now();
+  if (skip_if_busy_) {
+    if (busy_.exchange(true)) {
+      const std::size_t dropped = ++dropped_clouds_;
+      NODELET_WARN_THROTTLE(5.0,
+                            "skip_if_busy: dropped the cloud of %.3f s (frame '%s') while "
+                            "meshing the previous one (%zu dropped so far)",
+                            message->header.stamp.toSec(), message->header.frame_id.c_str(),
+                            dropped);
+      return;
+    }
+    meshAndPublish(*message, received);
+    busy_ = false;
+  } else {
+    meshAndPublish(*message, received);
+  }
+}
+
+void MedialScaffoldReconstructionNodelet::meshAndPublish(const sensor_msgs::PointCloud2 &message,
+                                                         Clock::time_point received) {
+  pcl::PCLPointCloud2 cloud;
+  pcl_conversions::toPCL(message, cloud);
+  const ros_bridge::MeshingOutcome outcome = ros_bridge::meshCloud(cloud, settings_);
+  const std::size_t point_count = static_cast<std::size_t>(message.width) * message.height;
+  if (!outcome.error.empty()) {
+    NODELET_ERROR("cloud of %.3f s (frame '%s', %ux%u = %zu points) not meshed: %s",
+                  message.header.stamp.toSec(), message.header.frame_id.c_str(), message.width,
+                  message.height, point_count, outcome.error.c_str());
+    return;
+  }
+  if (!outcome.warning.empty())
+    NODELET_WARN_ONCE("%s", outcome.warning.c_str());
+
+  // The mesh carries the message's own cloud, so every field rides along.
+  pcl_msgs::PolygonMeshPtr mesh(new pcl_msgs::PolygonMesh);
+  mesh->header = message.header;
+  mesh->cloud = message;
+  mesh->polygons.resize(outcome.polygons.size());
+  for (std::size_t t = 0; t < outcome.polygons.size(); ++t)
+    mesh->polygons[t].vertices.assign(outcome.polygons[t].vertices.begin(),
+                                      outcome.polygons[t].vertices.end());
+  mesh_publisher_.publish(mesh);
+  const Clock::time_point mesh_published = Clock::now();
+
+  publishMarkers(message.header, cloud, outcome);
+  const Clock::time_point markers_published = Clock::now();
+
+  const double to_mesh = secondsBetween(received, mesh_published);
+  NODELET_INFO("cloud %ux%u (%zu points, %zu finite), frame '%s': %zu triangles, %zu boundary "
+               "loops; mesh published %.3f s after receipt (library %.3f s, conversion and "
+               "publishing %.3f s), markers %.3f s",
+               message.width, message.height, point_count, outcome.finite_points,
+               message.header.frame_id.c_str(), outcome.polygons.size(),
+               outcome.boundary_loops.size(), to_mesh, outcome.library_seconds,
+               to_mesh - outcome.library_seconds, secondsBetween(received, markers_published));
+}
+
+void MedialScaffoldReconstructionNodelet::publishMarkers(
+    const std_msgs::Header &header, const pcl::PCLPointCloud2 &cloud,
+    const ros_bridge::MeshingOutcome &outcome) {
+  // Marker arrays are big (three points per triangle): build them only for
+  // someone listening, or for a latched topic's later listeners.
+  if (latch_ || mesh_marker_publisher_.getNumSubscribers() > 0) {
+    visualization_msgs::MarkerPtr marker(new visualization_msgs::Marker);
+    marker->header = header;
+    marker->ns = "pcl_ms_mesh";
+    marker->type = visualization_msgs::Marker::TRIANGLE_LIST;
+    marker->pose.orientation.w = 1.0;
+    marker->scale.x = marker->scale.y = marker->scale.z = 1.0;
+    // Grey where the cloud has no colour.
+    marker->color.r = marker->color.g = marker->color.b = 0.8f;
+    marker->color.a = 1.0f;
+    fillMarker(ros_bridge::triangleListGeometry(cloud, outcome.polygons), *marker);
+    mesh_marker_publisher_.publish(marker);
+  }
+  if (latch_ || boundary_marker_publisher_.getNumSubscribers() > 0) {
+    visualization_msgs::MarkerPtr marker(new visualization_msgs::Marker);
+    marker->header = header;
+    marker->ns = "pcl_ms_boundary";
+    marker->type = visualization_msgs::Marker::LINE_LIST;
+    marker->pose.orientation.w = 1.0;
+    // Lines a fifth of the median circumradius wide stay visible at any scale.
+    marker->scale.x = outcome.median_circumradius > 0 ? 0.2 * outcome.median_circumradius : 0.001;
+    marker->color.b = 1.0f; // blue, as the paper draws boundaries
+    marker->color.a = 1.0f;
+    fillMarker(ros_bridge::boundaryLineGeometry(cloud, outcome.boundary_loops), *marker);
+    boundary_marker_publisher_.publish(marker);
+  }
+}
+
+} // namespace pcl_ms
+
+PLUGINLIB_EXPORT_CLASS(pcl_ms::MedialScaffoldReconstructionNodelet, nodelet::Nodelet)
