@@ -215,8 +215,9 @@ void MedialScaffoldReconstructionNodelet::publishMarkers(
     marker->ns = "pcl_ms_boundary";
     marker->type = visualization_msgs::Marker::LINE_LIST;
     marker->pose.orientation.w = 1.0;
-    // Lines a fifth of the median circumradius wide stay visible at any scale.
-    marker->scale.x = outcome.median_circumradius > 0 ? 0.2 * outcome.median_circumradius : 0.001;
+    // Lines as wide as the median circumradius (about the point spacing)
+    // stand out at any scale of cloud.
+    marker->scale.x = outcome.median_circumradius > 0 ? outcome.median_circumradius : 0.001;
     marker->color.b = 1.0f; // blue, as the paper draws boundaries
     marker->color.a = 1.0f;
     fillMarker(ros_bridge::boundaryLineGeometry(cloud, outcome.boundary_loops), *marker);
