@@ -69,22 +69,33 @@ float readFloat(const pcl::PCLPointCloud2 &cloud, std::size_t offset) {
   return value;
 }
 
-// Position of point `index`, or nothing when it is not finite.
-bool readPosition(const pcl::PCLPointCloud2 &cloud, const std::array<std::uint32_t, 3> &offsets,
-                  std::size_t index, std::array<float, 3> &position) {
-  const std::size_t base = pointOffset(cloud, index);
-  for (int axis = 0; axis < 3; ++axis) {
-    position[axis] = readFloat(cloud, base + offsets[axis]);
-    if (!std::isfinite(position[axis]))
-      return false;
-  }
-  return true;
-}
+// Reads positions from a cloud whose layout checkCloudLayout accepted.
+class PositionReader {
+public:
+  explicit PositionReader(const pcl::PCLPointCloud2 &cloud)
+      : cloud_(cloud), offsets_{findField(cloud.fields, "x")->offset,
+                                findField(cloud.fields, "y")->offset,
+                                findField(cloud.fields, "z")->offset},
+        point_count_(static_cast<std::size_t>(cloud.width) * cloud.height) {}
 
-std::array<std::uint32_t, 3> positionOffsets(const pcl::PCLPointCloud2 &cloud) {
-  return {findField(cloud.fields, "x")->offset, findField(cloud.fields, "y")->offset,
-          findField(cloud.fields, "z")->offset};
-}
+  // False when `index` lies outside the cloud or the point is not finite.
+  bool read(pcl::index_t index, std::array<float, 3> &position) const {
+    if (index < 0 || static_cast<std::size_t>(index) >= point_count_)
+      return false;
+    const std::size_t base = pointOffset(cloud_, static_cast<std::size_t>(index));
+    for (int axis = 0; axis < 3; ++axis) {
+      position[axis] = readFloat(cloud_, base + offsets_[axis]);
+      if (!std::isfinite(position[axis]))
+        return false;
+    }
+    return true;
+  }
+
+private:
+  const pcl::PCLPointCloud2 &cloud_;
+  std::array<std::uint32_t, 3> offsets_;
+  std::size_t point_count_;
+};
 
 // PCL and ROS pack colour as 0xAARRGGBB in a 4-byte rgb or rgba field. Alpha
 // is ignored: "rgb" fields often leave it 0, and RViz would hide the mesh.
@@ -106,19 +117,8 @@ std::array<float, 4> readColor(const pcl::PCLPointCloud2 &cloud, std::uint32_t f
           static_cast<float>(packed & 0xff) / 255.0f, 1.0f};
 }
 
-pcl_ms::Parameters toParameters(const MeshingSettings &settings) {
-  pcl_ms::Parameters parameters;
-  parameters.rho = settings.rho;
-  parameters.fill_holes_max_edges = settings.fill_holes;
-  parameters.use_normals = settings.use_normals;
-  parameters.num_threads = settings.threads;
-  parameters.bucket_points = settings.bucket_points;
-  parameters.grid_buckets = settings.grid;
-  return parameters;
-}
-
 template <typename PointT>
-void meshTypedCloud(const pcl::PCLPointCloud2 &cloud, const MeshingSettings &settings,
+void meshTypedCloud(const pcl::PCLPointCloud2 &cloud, const pcl_ms::Parameters &parameters,
                     bool use_normals, MeshingOutcome &outcome) {
   const Clock::time_point conversion_start = Clock::now();
   typename pcl::PointCloud<PointT>::Ptr points(new pcl::PointCloud<PointT>);
@@ -126,9 +126,8 @@ void meshTypedCloud(const pcl::PCLPointCloud2 &cloud, const MeshingSettings &set
   outcome.conversion_seconds = secondsSince(conversion_start);
 
   pcl::MedialScaffoldReconstruction<PointT> reconstruction;
-  pcl_ms::Parameters parameters = toParameters(settings);
-  parameters.use_normals = use_normals;
   reconstruction.setParameters(parameters);
+  reconstruction.setUseNormals(use_normals);
   reconstruction.setInputCloud(points);
 
   // This overload copies the input into `output_points` (the polygon-mesh one
@@ -151,10 +150,6 @@ void meshTypedCloud(const pcl::PCLPointCloud2 &cloud, const MeshingSettings &set
 }
 
 } // namespace
-
-std::string checkSettings(const MeshingSettings &settings) {
-  return toParameters(settings).validate();
-}
 
 bool hasNormalFields(const std::vector<pcl::PCLPointField> &fields) {
   return isFloatField(findField(fields, "normal_x")) &&
@@ -214,19 +209,19 @@ std::string checkCloudLayout(const pcl::PCLPointCloud2 &cloud) {
   return {};
 }
 
-MeshingOutcome meshCloud(const pcl::PCLPointCloud2 &cloud, const MeshingSettings &settings) {
+MeshingOutcome meshCloud(const pcl::PCLPointCloud2 &cloud, const pcl_ms::Parameters &parameters) {
   MeshingOutcome outcome;
   outcome.error = checkCloudLayout(cloud);
   if (!outcome.error.empty())
     return outcome;
-  if (settings.use_normals && !hasNormalFields(cloud.fields))
+  if (parameters.use_normals && !hasNormalFields(cloud.fields))
     outcome.warning = "use_normals is set but the cloud has no FLOAT32 normal_x/y/z fields: "
                       "meshed without normals";
   try {
-    if (choosePointType(cloud.fields, settings.use_normals) == MeshingPointType::xyz_normal)
-      meshTypedCloud<pcl::PointNormal>(cloud, settings, true, outcome);
+    if (choosePointType(cloud.fields, parameters.use_normals) == MeshingPointType::xyz_normal)
+      meshTypedCloud<pcl::PointNormal>(cloud, parameters, true, outcome);
     else
-      meshTypedCloud<pcl::PointXYZ>(cloud, settings, false, outcome);
+      meshTypedCloud<pcl::PointXYZ>(cloud, parameters, false, outcome);
   } catch (const std::exception &error) {
     // Out of memory on a huge cloud, or anything PCL throws: report, don't die.
     outcome.polygons.clear();
@@ -241,9 +236,8 @@ MarkerGeometry triangleListGeometry(const pcl::PCLPointCloud2 &cloud,
   MarkerGeometry geometry;
   if (!checkCloudLayout(cloud).empty())
     return geometry;
-  const std::array<std::uint32_t, 3> offsets = positionOffsets(cloud);
+  const PositionReader positions(cloud);
   const pcl::PCLPointField *color = colorField(cloud);
-  const std::size_t point_count = static_cast<std::size_t>(cloud.width) * cloud.height;
 
   geometry.points.reserve(3 * polygons.size());
   if (color)
@@ -253,11 +247,8 @@ MarkerGeometry triangleListGeometry(const pcl::PCLPointCloud2 &cloud,
       continue;
     std::array<std::array<float, 3>, 3> corners;
     bool usable = true;
-    for (int corner = 0; corner < 3 && usable; ++corner) {
-      const auto index = polygon.vertices[corner];
-      usable = index >= 0 && static_cast<std::size_t>(index) < point_count &&
-               readPosition(cloud, offsets, static_cast<std::size_t>(index), corners[corner]);
-    }
+    for (int corner = 0; corner < 3 && usable; ++corner)
+      usable = positions.read(polygon.vertices[corner], corners[corner]);
     if (!usable)
       continue;
     for (int corner = 0; corner < 3; ++corner) {
@@ -275,21 +266,16 @@ MarkerGeometry boundaryLineGeometry(const pcl::PCLPointCloud2 &cloud,
   MarkerGeometry geometry;
   if (!checkCloudLayout(cloud).empty())
     return geometry;
-  const std::array<std::uint32_t, 3> offsets = positionOffsets(cloud);
-  const std::size_t point_count = static_cast<std::size_t>(cloud.width) * cloud.height;
+  const PositionReader positions(cloud);
 
   for (const pcl::Vertices &loop : loops) {
     const std::size_t length = loop.vertices.size();
     if (length < 2)
       continue;
     for (std::size_t i = 0; i < length; ++i) {
-      const auto from = loop.vertices[i];
-      const auto to = loop.vertices[(i + 1) % length];
       std::array<float, 3> from_position, to_position;
-      if (from < 0 || to < 0 || static_cast<std::size_t>(from) >= point_count ||
-          static_cast<std::size_t>(to) >= point_count ||
-          !readPosition(cloud, offsets, static_cast<std::size_t>(from), from_position) ||
-          !readPosition(cloud, offsets, static_cast<std::size_t>(to), to_position))
+      if (!positions.read(loop.vertices[i], from_position) ||
+          !positions.read(loop.vertices[(i + 1) % length], to_position))
         continue;
       geometry.points.push_back(from_position);
       geometry.points.push_back(to_position);

@@ -9,6 +9,7 @@
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/PCLPointField.h>
 #include <pcl/Vertices.h>
+#include <pcl_ms/types.h>
 
 #include <array>
 #include <cstddef>
@@ -17,20 +18,6 @@
 
 namespace pcl_ms {
 namespace ros_bridge {
-
-/// The knobs of pcl::MedialScaffoldReconstruction that the nodes expose.
-struct MeshingSettings {
-  double rho = 5.0;
-  int fill_holes = 8;
-  bool use_normals = false;
-  int threads = 1;
-  std::size_t bucket_points = 0;
-  int grid = 0;
-};
-
-/// Empty when the library accepts the settings, else its reason (so a node
-/// can say so at start-up instead of once per cloud).
-std::string checkSettings(const MeshingSettings &settings);
 
 /// The point type a cloud is converted to for meshing. Only positions (and
 /// normals when asked for) matter: the published mesh keeps the message's
@@ -60,9 +47,11 @@ struct MeshingOutcome {
   double library_seconds = 0;                ///< pcl::MedialScaffoldReconstruction::reconstruct
 };
 
-/// Checks, converts and meshes one cloud. Never throws: every failure,
-/// including the library's own reason, comes back in MeshingOutcome::error.
-MeshingOutcome meshCloud(const pcl::PCLPointCloud2 &cloud, const MeshingSettings &settings);
+/// Checks, converts and meshes one cloud with the library's parameters
+/// (pcl::MedialScaffoldReconstruction::setParameters). Never throws: every
+/// failure, including the library's own reason, comes back in
+/// MeshingOutcome::error.
+MeshingOutcome meshCloud(const pcl::PCLPointCloud2 &cloud, const pcl_ms::Parameters &parameters);
 
 /// Points (and optional per-point colours) of one RViz marker.
 struct MarkerGeometry {

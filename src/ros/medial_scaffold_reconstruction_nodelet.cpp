@@ -29,7 +29,7 @@ private:
   void publishMarkers(const std_msgs::Header &header, const pcl::PCLPointCloud2 &cloud,
                       const ros_bridge::MeshingOutcome &outcome);
 
-  ros_bridge::MeshingSettings settings_;
+  pcl_ms::Parameters parameters_;
   int queue_size_ = 1;
   bool latch_ = false;
   bool skip_if_busy_ = false;
@@ -48,6 +48,17 @@ namespace {
 double secondsBetween(std::chrono::steady_clock::time_point start,
                       std::chrono::steady_clock::time_point end) {
   return std::chrono::duration<double>(end - start).count();
+}
+
+visualization_msgs::MarkerPtr makeMarker(const std_msgs::Header &header, const char *name_space,
+                                         std::int32_t type) {
+  visualization_msgs::MarkerPtr marker(new visualization_msgs::Marker);
+  marker->header = header;
+  marker->ns = name_space;
+  marker->type = type;
+  marker->pose.orientation.w = 1.0;
+  marker->color.a = 1.0f;
+  return marker;
 }
 
 void fillMarker(const ros_bridge::MarkerGeometry &geometry, visualization_msgs::Marker &marker) {
@@ -72,10 +83,11 @@ void fillMarker(const ros_bridge::MarkerGeometry &geometry, visualization_msgs::
 } // namespace
 
 void MedialScaffoldReconstructionNodelet::readParameters(ros::NodeHandle &private_node) {
-  private_node.param("rho", settings_.rho, settings_.rho);
-  private_node.param("fill_holes", settings_.fill_holes, settings_.fill_holes);
-  private_node.param("use_normals", settings_.use_normals, settings_.use_normals);
-  private_node.param("threads", settings_.threads, settings_.threads);
+  private_node.param("rho", parameters_.rho, parameters_.rho);
+  private_node.param("fill_holes", parameters_.fill_holes_max_edges,
+                     parameters_.fill_holes_max_edges);
+  private_node.param("use_normals", parameters_.use_normals, parameters_.use_normals);
+  private_node.param("threads", parameters_.num_threads, parameters_.num_threads);
   int bucket_points = 0;
   private_node.param("bucket_points", bucket_points, 0);
   if (bucket_points < 0) {
@@ -83,8 +95,8 @@ void MedialScaffoldReconstructionNodelet::readParameters(ros::NodeHandle &privat
                   bucket_points);
     bucket_points = 0;
   }
-  settings_.bucket_points = static_cast<std::size_t>(bucket_points);
-  private_node.param("grid", settings_.grid, settings_.grid);
+  parameters_.bucket_points = static_cast<std::size_t>(bucket_points);
+  private_node.param("grid", parameters_.grid_buckets, parameters_.grid_buckets);
   private_node.param("queue_size", queue_size_, queue_size_);
   if (queue_size_ < 1) {
     NODELET_ERROR("parameter queue_size must be >= 1 (got %d): using 1", queue_size_);
@@ -99,10 +111,10 @@ void MedialScaffoldReconstructionNodelet::onInit() {
   ros::NodeHandle &private_node = getPrivateNodeHandle();
   readParameters(private_node);
 
-  const std::string settings_error = ros_bridge::checkSettings(settings_);
-  if (!settings_error.empty())
+  const std::string parameters_error = parameters_.validate();
+  if (!parameters_error.empty())
     NODELET_ERROR("invalid parameters, every cloud will be refused until they are fixed: %s",
-                  settings_error.c_str());
+                  parameters_error.c_str());
 
   mesh_publisher_ = node.advertise<pcl_msgs::PolygonMesh>("mesh", 1, latch_);
   mesh_marker_publisher_ = node.advertise<visualization_msgs::Marker>("mesh_marker", 1, latch_);
@@ -126,10 +138,10 @@ void MedialScaffoldReconstructionNodelet::onInit() {
                "skip_if_busy %s)",
                cloud_subscriber_.getTopic().c_str(), mesh_publisher_.getTopic().c_str(),
                mesh_marker_publisher_.getTopic().c_str(),
-               boundary_marker_publisher_.getTopic().c_str(), settings_.rho, settings_.fill_holes,
-               settings_.use_normals ? "true" : "false", settings_.threads, settings_.bucket_points,
-               settings_.grid, queue_size_, latch_ ? "true" : "false",
-               skip_if_busy_ ? "true" : "false");
+               boundary_marker_publisher_.getTopic().c_str(), parameters_.rho,
+               parameters_.fill_holes_max_edges, parameters_.use_normals ? "true" : "false",
+               parameters_.num_threads, parameters_.bucket_points, parameters_.grid_buckets,
+               queue_size_, latch_ ? "true" : "false", skip_if_busy_ ? "true" : "false");
 }
 
 void MedialScaffoldReconstructionNodelet::cloudCallback(
@@ -156,7 +168,7 @@ void MedialScaffoldReconstructionNodelet::meshAndPublish(const sensor_msgs::Poin
                                                          Clock::time_point received) {
   pcl::PCLPointCloud2 cloud;
   pcl_conversions::toPCL(message, cloud);
-  const ros_bridge::MeshingOutcome outcome = ros_bridge::meshCloud(cloud, settings_);
+  const ros_bridge::MeshingOutcome outcome = ros_bridge::meshCloud(cloud, parameters_);
   const std::size_t point_count = static_cast<std::size_t>(message.width) * message.height;
   if (!outcome.error.empty()) {
     NODELET_ERROR("cloud of %.3f s (frame '%s', %ux%u = %zu points) not meshed: %s",
@@ -197,29 +209,21 @@ void MedialScaffoldReconstructionNodelet::publishMarkers(
   // Marker arrays are big (three points per triangle): build them only for
   // someone listening, or for a latched topic's later listeners.
   if (latch_ || mesh_marker_publisher_.getNumSubscribers() > 0) {
-    visualization_msgs::MarkerPtr marker(new visualization_msgs::Marker);
-    marker->header = header;
-    marker->ns = "pcl_ms_mesh";
-    marker->type = visualization_msgs::Marker::TRIANGLE_LIST;
-    marker->pose.orientation.w = 1.0;
+    visualization_msgs::MarkerPtr marker =
+        makeMarker(header, "pcl_ms_mesh", visualization_msgs::Marker::TRIANGLE_LIST);
     marker->scale.x = marker->scale.y = marker->scale.z = 1.0;
     // Grey where the cloud has no colour.
     marker->color.r = marker->color.g = marker->color.b = 0.8f;
-    marker->color.a = 1.0f;
     fillMarker(ros_bridge::triangleListGeometry(cloud, outcome.polygons), *marker);
     mesh_marker_publisher_.publish(marker);
   }
   if (latch_ || boundary_marker_publisher_.getNumSubscribers() > 0) {
-    visualization_msgs::MarkerPtr marker(new visualization_msgs::Marker);
-    marker->header = header;
-    marker->ns = "pcl_ms_boundary";
-    marker->type = visualization_msgs::Marker::LINE_LIST;
-    marker->pose.orientation.w = 1.0;
+    visualization_msgs::MarkerPtr marker =
+        makeMarker(header, "pcl_ms_boundary", visualization_msgs::Marker::LINE_LIST);
     // Lines as wide as the median circumradius (about the point spacing)
     // stand out at any scale of cloud.
     marker->scale.x = outcome.median_circumradius > 0 ? outcome.median_circumradius : 0.001;
     marker->color.b = 1.0f; // blue, as the paper draws boundaries
-    marker->color.a = 1.0f;
     fillMarker(ros_bridge::boundaryLineGeometry(cloud, outcome.boundary_loops), *marker);
     boundary_marker_publisher_.publish(marker);
   }

@@ -156,17 +156,10 @@ TEST(RosBridgePointType, NormalsOnlyWhenAskedForAndPresent) {
   EXPECT_EQ(choosePointType(with_normals, true), MeshingPointType::xyz);
 }
 
-TEST(RosBridgeSettings, ReportsTheLibrarysReason) {
-  MeshingSettings settings;
-  EXPECT_EQ(checkSettings(settings), "");
-  settings.rho = -1;
-  EXPECT_NE(checkSettings(settings).find("rho"), std::string::npos);
-}
-
 TEST(RosBridgeMeshing, MeshesTheBunnyManifold) {
   pcl::PCLPointCloud2 bunny;
   ASSERT_EQ(pcl::io::loadPCDFile(PCL_MS_DATA_DIR "/bunny.pcd", bunny), 0);
-  const MeshingOutcome outcome = meshCloud(bunny, MeshingSettings());
+  const MeshingOutcome outcome = meshCloud(bunny, pcl_ms::Parameters());
   ASSERT_EQ(outcome.error, "");
   EXPECT_EQ(outcome.finite_points, 35947u);
   // The reference surface has 69,451 triangles; the library keeps > 98 %.
@@ -181,7 +174,7 @@ TEST(RosBridgeMeshing, OrganizedFrameWithNaNsIndexesOnlyFinitePoints) {
   const pcl::PCLPointCloud2 frame = makeOrganizedFrame();
   const std::size_t finite = countFinitePoints(frame);
   ASSERT_LT(finite, 1200u); // the disc of NaNs is there
-  const MeshingOutcome outcome = meshCloud(frame, MeshingSettings());
+  const MeshingOutcome outcome = meshCloud(frame, pcl_ms::Parameters());
   ASSERT_EQ(outcome.error, "");
   EXPECT_EQ(outcome.finite_points, finite);
   // A height field of n points has about 2n triangles.
@@ -207,28 +200,28 @@ TEST(RosBridgeMeshing, BadCloudsComeBackAsErrorsNotCrashes) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const pcl::PCLPointCloud2 all_nan =
       makeColoredCloud(4, 1, {{nan, nan, nan, 0}, {nan, 0, 0, 0}, {0, nan, 0, 0}, {0, 0, nan, 0}});
-  EXPECT_NE(meshCloud(all_nan, MeshingSettings()).error, "");
+  EXPECT_NE(meshCloud(all_nan, pcl_ms::Parameters()).error, "");
 
   const pcl::PCLPointCloud2 collinear =
       makeColoredCloud(4, 1, {{0, 0, 0, 0}, {1, 1, 1, 0}, {2, 2, 2, 0}, {3, 3, 3, 0}});
-  const MeshingOutcome collinear_outcome = meshCloud(collinear, MeshingSettings());
+  const MeshingOutcome collinear_outcome = meshCloud(collinear, pcl_ms::Parameters());
   EXPECT_NE(collinear_outcome.error, "");
   EXPECT_TRUE(collinear_outcome.polygons.empty());
 
   pcl::PCLPointCloud2 no_y = makeOrganizedFrame();
   no_y.fields.erase(no_y.fields.begin() + 1);
-  EXPECT_NE(meshCloud(no_y, MeshingSettings()).error.find("no 'y' field"), std::string::npos);
+  EXPECT_NE(meshCloud(no_y, pcl_ms::Parameters()).error.find("no 'y' field"), std::string::npos);
 
-  MeshingSettings bad_settings;
-  bad_settings.fill_holes = 2;
-  EXPECT_NE(meshCloud(makeOrganizedFrame(), bad_settings).error.find("fill_holes"),
+  pcl_ms::Parameters bad_parameters;
+  bad_parameters.fill_holes_max_edges = 2;
+  EXPECT_NE(meshCloud(makeOrganizedFrame(), bad_parameters).error.find("fill_holes"),
             std::string::npos);
 }
 
 TEST(RosBridgeMeshing, WarnsWhenNormalsAreAskedForButAbsent) {
-  MeshingSettings settings;
-  settings.use_normals = true;
-  const MeshingOutcome outcome = meshCloud(makeOrganizedFrame(), settings);
+  pcl_ms::Parameters parameters;
+  parameters.use_normals = true;
+  const MeshingOutcome outcome = meshCloud(makeOrganizedFrame(), parameters);
   EXPECT_EQ(outcome.error, "");
   EXPECT_NE(outcome.warning.find("use_normals"), std::string::npos);
   EXPECT_FALSE(outcome.polygons.empty());
