@@ -14,7 +14,8 @@
 
 #include <atomic>
 #include <chrono>
-#include <mutex>
+#include <cstdint>
+#include <exception>
 
 namespace pcl_ms {
 
@@ -147,21 +148,22 @@ void MedialScaffoldReconstructionNodelet::onInit() {
 void MedialScaffoldReconstructionNodelet::cloudCallback(
     const sensor_msgs::PointCloud2ConstPtr &message) {
   const Clock::time_point received = Clock::now();
-  if (skip_if_busy_) {
-    if (busy_.exchange(true)) {
-      const std::size_t dropped = ++dropped_clouds_;
-      NODELET_WARN_THROTTLE(5.0,
-                            "skip_if_busy: dropped the cloud of %.3f s (frame '%s') while "
-                            "meshing the previous one (%zu dropped so far)",
-                            message->header.stamp.toSec(), message->header.frame_id.c_str(),
-                            dropped);
-      return;
-    }
-    meshAndPublish(*message, received);
-    busy_ = false;
-  } else {
-    meshAndPublish(*message, received);
+  if (skip_if_busy_ && busy_.exchange(true)) {
+    const std::size_t dropped = ++dropped_clouds_;
+    NODELET_WARN_THROTTLE(5.0,
+                          "skip_if_busy: dropped the cloud of %.3f s (frame '%s') while meshing "
+                          "the previous one (%zu dropped so far)",
+                          message->header.stamp.toSec(), message->header.frame_id.c_str(), dropped);
+    return;
   }
+  try {
+    meshAndPublish(*message, received);
+  } catch (const std::exception &error) {
+    // Say, out of memory copying a huge cloud: that cloud is lost, not the node.
+    NODELET_ERROR("cloud of %.3f s (frame '%s') not meshed: %s", message->header.stamp.toSec(),
+                  message->header.frame_id.c_str(), error.what());
+  }
+  busy_ = false;
 }
 
 void MedialScaffoldReconstructionNodelet::meshAndPublish(const sensor_msgs::PointCloud2 &message,
