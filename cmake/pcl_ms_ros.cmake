@@ -140,7 +140,18 @@ if(PCL_MS_BUILD_TESTS)
   if(NOT PCL_MS_ROSTEST)
     message(FATAL_ERROR "ROS 1 was found but rostest was not (Debian package python3-rostest)")
   endif()
+  set(PCL_MS_ROS_TEST_ENVIRONMENT
+    "ROS_PACKAGE_PATH=${PROJECT_SOURCE_DIR};CMAKE_PREFIX_PATH=${PCL_MS_ROS_PREFIX}:/usr;ROS_HOME=${CMAKE_BINARY_DIR}/ros_home")
   file(GLOB PCL_MS_ROSTEST_FILES CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/tests/ros/*.test")
+  file(GLOB PCL_MS_LAUNCH_FILES CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/launch/*.launch")
+  # Every launch file loads and names nodes that exist (demo.launch is not
+  # run by the tests: it publishes forever).
+  add_test(NAME roslaunch_check
+    COMMAND /usr/bin/python3 "${PROJECT_SOURCE_DIR}/tests/ros/check_launch_files.py"
+            ${PCL_MS_LAUNCH_FILES} ${PCL_MS_ROSTEST_FILES})
+  set_tests_properties(roslaunch_check PROPERTIES
+    TIMEOUT 120
+    ENVIRONMENT "${PCL_MS_ROS_TEST_ENVIRONMENT}")
   foreach(_test_file IN LISTS PCL_MS_ROSTEST_FILES)
     get_filename_component(_name "${_test_file}" NAME_WE)
     # rostest starts its own roscore on a free port; logs stay in the build.
@@ -150,6 +161,6 @@ if(PCL_MS_BUILD_TESTS)
     set_tests_properties(rostest.${_name} PROPERTIES
       TIMEOUT 300
       FAIL_REGULAR_EXPRESSION "RESULT: FAIL"
-      ENVIRONMENT "ROS_PACKAGE_PATH=${PROJECT_SOURCE_DIR};CMAKE_PREFIX_PATH=${PCL_MS_ROS_PREFIX}:/usr;ROS_HOME=${CMAKE_BINARY_DIR}/ros_home;PYTHONPATH=${PROJECT_SOURCE_DIR}/tests/ros")
+      ENVIRONMENT "${PCL_MS_ROS_TEST_ENVIRONMENT}")
   endforeach()
 endif()
