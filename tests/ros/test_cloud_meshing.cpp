@@ -227,6 +227,34 @@ TEST(RosBridgeMeshing, WarnsWhenNormalsAreAskedForButAbsent) {
   EXPECT_FALSE(outcome.polygons.empty());
 }
 
+TEST(RosBridgeMeshing, UsesTheCloudsNormalsWhenAskedTo) {
+  // A 30 x 20 height field with normal_x/y/z (all towards the camera) and an
+  // intensity field between them, as a LiDAR driver might lay them out.
+  pcl::PCLPointCloud2 cloud;
+  cloud.width = 30;
+  cloud.height = 20;
+  cloud.fields = {makeField("x", 0),          makeField("y", 4),         makeField("z", 8),
+                  makeField("intensity", 12), makeField("normal_x", 16), makeField("normal_y", 20),
+                  makeField("normal_z", 24)};
+  cloud.point_step = 28;
+  cloud.row_step = cloud.width * cloud.point_step;
+  cloud.data.resize(static_cast<std::size_t>(cloud.row_step) * cloud.height);
+  for (std::uint32_t i = 0; i < cloud.width * cloud.height; ++i) {
+    const float u = static_cast<float>(i % cloud.width) * 0.01f;
+    const float v = static_cast<float>(i / cloud.width) * 0.01f;
+    const float values[7] = {u,    v,    1.0f + 0.02f * std::sin(20.0f * u + 10.0f * v), 0.5f, 0.0f,
+                             0.0f, -1.0f};
+    std::memcpy(&cloud.data[i * cloud.point_step], values, sizeof values);
+  }
+  pcl_ms::Parameters parameters;
+  parameters.use_normals = true;
+  const MeshingOutcome outcome = meshCloud(cloud, parameters);
+  ASSERT_EQ(outcome.error, "");
+  EXPECT_EQ(outcome.warning, "");
+  EXPECT_GT(outcome.polygons.size(), 900u); // about 2 per point
+  EXPECT_EQ(countNonManifoldEdges(outcome.polygons), 0u);
+}
+
 TEST(RosBridgeMarkers, TriangleListSkipsUnusablePolygons) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const pcl::PCLPointCloud2 cloud = makeColoredCloud(5, 1,
