@@ -97,6 +97,15 @@ private:
   std::size_t point_count_;
 };
 
+// Marker geometry of a cloud whose layout can be read; none otherwise.
+template <typename AddGeometry>
+MarkerGeometry buildGeometry(const pcl::PCLPointCloud2 &cloud, AddGeometry add_geometry) {
+  MarkerGeometry geometry;
+  if (checkCloudLayout(cloud).empty())
+    add_geometry(PositionReader(cloud), geometry);
+  return geometry;
+}
+
 // PCL and ROS pack colour as 0xAARRGGBB in a 4-byte rgb or rgba field. Alpha
 // is ignored: "rgb" fields often leave it 0, and RViz would hide the mesh.
 const pcl::PCLPointField *colorField(const pcl::PCLPointCloud2 &cloud) {
@@ -233,55 +242,47 @@ MeshingOutcome meshCloud(const pcl::PCLPointCloud2 &cloud, const pcl_ms::Paramet
 
 MarkerGeometry triangleListGeometry(const pcl::PCLPointCloud2 &cloud,
                                     const std::vector<pcl::Vertices> &polygons) {
-  MarkerGeometry geometry;
-  if (!checkCloudLayout(cloud).empty())
-    return geometry;
-  const PositionReader positions(cloud);
-  const pcl::PCLPointField *color = colorField(cloud);
-
-  geometry.points.reserve(3 * polygons.size());
-  if (color)
-    geometry.colors.reserve(3 * polygons.size());
-  for (const pcl::Vertices &polygon : polygons) {
-    if (polygon.vertices.size() != 3)
-      continue;
-    std::array<std::array<float, 3>, 3> corners;
-    bool usable = true;
-    for (int corner = 0; corner < 3 && usable; ++corner)
-      usable = positions.read(polygon.vertices[corner], corners[corner]);
-    if (!usable)
-      continue;
-    for (int corner = 0; corner < 3; ++corner) {
-      geometry.points.push_back(corners[corner]);
-      if (color)
-        geometry.colors.push_back(
-            readColor(cloud, color->offset, static_cast<std::size_t>(polygon.vertices[corner])));
+  return buildGeometry(cloud, [&](const PositionReader &positions, MarkerGeometry &geometry) {
+    const pcl::PCLPointField *color = colorField(cloud);
+    geometry.points.reserve(3 * polygons.size());
+    if (color)
+      geometry.colors.reserve(3 * polygons.size());
+    for (const pcl::Vertices &polygon : polygons) {
+      if (polygon.vertices.size() != 3)
+        continue;
+      std::array<std::array<float, 3>, 3> corners;
+      bool usable = true;
+      for (int corner = 0; corner < 3 && usable; ++corner)
+        usable = positions.read(polygon.vertices[corner], corners[corner]);
+      if (!usable)
+        continue;
+      for (int corner = 0; corner < 3; ++corner) {
+        geometry.points.push_back(corners[corner]);
+        if (color)
+          geometry.colors.push_back(
+              readColor(cloud, color->offset, static_cast<std::size_t>(polygon.vertices[corner])));
+      }
     }
-  }
-  return geometry;
+  });
 }
 
 MarkerGeometry boundaryLineGeometry(const pcl::PCLPointCloud2 &cloud,
                                     const std::vector<pcl::Vertices> &loops) {
-  MarkerGeometry geometry;
-  if (!checkCloudLayout(cloud).empty())
-    return geometry;
-  const PositionReader positions(cloud);
-
-  for (const pcl::Vertices &loop : loops) {
-    const std::size_t length = loop.vertices.size();
-    if (length < 2)
-      continue;
-    for (std::size_t i = 0; i < length; ++i) {
-      std::array<float, 3> from_position, to_position;
-      if (!positions.read(loop.vertices[i], from_position) ||
-          !positions.read(loop.vertices[(i + 1) % length], to_position))
+  return buildGeometry(cloud, [&](const PositionReader &positions, MarkerGeometry &geometry) {
+    for (const pcl::Vertices &loop : loops) {
+      const std::size_t length = loop.vertices.size();
+      if (length < 2)
         continue;
-      geometry.points.push_back(from_position);
-      geometry.points.push_back(to_position);
+      for (std::size_t i = 0; i < length; ++i) {
+        std::array<float, 3> from_position, to_position;
+        if (!positions.read(loop.vertices[i], from_position) ||
+            !positions.read(loop.vertices[(i + 1) % length], to_position))
+          continue;
+        geometry.points.push_back(from_position);
+        geometry.points.push_back(to_position);
+      }
     }
-  }
-  return geometry;
+  });
 }
 
 } // namespace ros_bridge
