@@ -46,6 +46,8 @@ struct Options {
   int threads = 1;
   unsigned int bucket_points = 0; // 0: automatic
   int grid = 0;
+  std::vector<double> viewpoint; // empty, or x, y, z
+  bool no_viewpoint = false;
   bool quiet = false;
   bool help = false;
 };
@@ -57,8 +59,8 @@ void printHelp(const char *program) {
   print_info("  output  mesh: .ply (binary), .vtk or .obj; its vertices are the input points, in\n"
              "          order, with colours and normals where the format can hold them\n\n");
   print_info("Options:\n");
-  print_info("  -rho X          no triangle side reaches X * d_med, d_med being the median\n"
-             "                  circumradius of the candidate triangles (default ");
+  print_info("  -rho X          no triangle side reaches X times the local scale, the typical\n"
+             "                  circumradius of the surface triangles where it lies (default ");
   print_value("%g", pcl_ms::Parameters().rho);
   print_info(")\n");
   print_info("  -fill_holes K   close boundary loops of at most K edges, 0 = off (default ");
@@ -75,6 +77,11 @@ void printHelp(const char *program) {
   print_value("%zu", pcl_ms::automatic_bucketing_threshold);
   print_info(" points (default 0)\n");
   print_info("  -grid N         cut the bounding box into N x N x N buckets instead\n");
+  print_info("  -viewpoint X,Y,Z  where a one-view scan was taken from: open surfaces face it\n"
+             "                  and are never left one-sided (default: the sensor origin (PCD\n"
+             "                  VIEWPOINT) of an organized cloud, i.e. a depth frame, or a\n"
+             "                  non-zero one; none for other clouds)\n");
+  print_info("  -no_viewpoint   no viewpoint, even for an organized cloud\n");
   print_info("  -q              quiet: print nothing but errors\n");
   print_info("  -h              this help\n\n");
   print_info("Exit status: 0 success, 1 bad arguments, 2 file error, 3 reconstruction failed.\n");
@@ -83,8 +90,8 @@ void printHelp(const char *program) {
 /// Collects the two file names and checks every option and its value.
 /// Numbers are read with PCL's parser, which rejects trailing garbage.
 bool parseArguments(int argc, char **argv, Options &options, std::string &error) {
-  const std::vector<std::string> value_options = {"-rho", "-fill_holes", "-threads",
-                                                  "-bucket_points", "-grid"};
+  const std::vector<std::string> value_options = {"-rho",           "-fill_holes", "-threads",
+                                                  "-bucket_points", "-grid",       "-viewpoint"};
   std::vector<std::string> positional;
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
@@ -94,6 +101,8 @@ bool parseArguments(int argc, char **argv, Options &options, std::string &error)
       options.normals = true;
     } else if (argument == "-q") {
       options.quiet = true;
+    } else if (argument == "-no_viewpoint") {
+      options.no_viewpoint = true;
     } else if (std::find(value_options.begin(), value_options.end(), argument) !=
                value_options.end()) {
       if (i + 1 >= argc) {
@@ -131,6 +140,13 @@ bool parseArguments(int argc, char **argv, Options &options, std::string &error)
   if (pcl::console::find_argument(argc, argv, "-grid") >= 0 &&
       pcl::console::parse_argument(argc, argv, "-grid", options.grid) < 0)
     return badValue("-grid");
+  if (const int index = pcl::console::find_argument(argc, argv, "-viewpoint"); index >= 0) {
+    pcl::console::parse_x_arguments(argc, argv, "-viewpoint", options.viewpoint);
+    if (options.viewpoint.size() != 3) {
+      error = std::string("-viewpoint: '") + argv[index + 1] + "' is not three numbers x,y,z";
+      return false;
+    }
+  }
 
   if (positional.size() != 2) {
     error = "expected input and output file names, got " + std::to_string(positional.size()) +
@@ -167,14 +183,17 @@ bool fileStep(const char *verb, const std::string &path, bool verbose, double &m
 /// Converts the cloud to PointT, meshes it and returns the polygons, which
 /// index the cloud's points directly.
 template <typename PointT>
-bool reconstructAs(const pcl::PCLPointCloud2 &cloud, const pcl_ms::Parameters &parameters,
+bool reconstructAs(const pcl::PCLPointCloud2 &cloud, const Eigen::Vector4f &sensor_origin,
+                   const pcl_ms::Parameters &parameters, bool use_sensor_origin,
                    std::vector<pcl::Vertices> &polygons, pcl_ms::Result &result,
                    std::string &error) {
   auto points = pcl::make_shared<pcl::PointCloud<PointT>>();
   pcl::fromPCLPointCloud2(cloud, *points);
+  points->sensor_origin_ = sensor_origin;
   pcl::MedialScaffoldReconstruction<PointT> reconstruction;
   reconstruction.setInputCloud(points);
   reconstruction.setParameters(parameters);
+  reconstruction.setUseSensorOrigin(use_sensor_origin);
   pcl::PolygonMesh mesh;
   {
     SilencePclMessages silence;
@@ -287,6 +306,8 @@ int run(int argc, char **argv) {
   parameters.num_threads = options.threads;
   parameters.bucket_points = options.bucket_points;
   parameters.grid_buckets = options.grid;
+  if (!options.viewpoint.empty())
+    parameters.viewpoint = {{options.viewpoint[0], options.viewpoint[1], options.viewpoint[2]}};
   if (const std::string reason = parameters.validate(); !reason.empty())
     return fail(kBadArguments, reason);
 
@@ -304,9 +325,11 @@ int run(int argc, char **argv) {
   const bool verbose = !options.quiet;
   pcl::console::TicToc timer;
   pcl::PCLPointCloud2 cloud;
+  Eigen::Vector4f sensor_origin;
   double load_ms = 0;
-  if (!fileStep("Loading", options.input, verbose, load_ms,
-                [&] { return pcl_ms::loadPointCloud(options.input, cloud, error); }))
+  if (!fileStep("Loading", options.input, verbose, load_ms, [&] {
+        return pcl_ms::loadPointCloud(options.input, cloud, error, &sensor_origin);
+      }))
     return fail(kIoFailure, error);
   if (verbose) {
     print_info("[done, ");
@@ -329,7 +352,17 @@ int run(int argc, char **argv) {
     print_info(", normals ");
     print_value("%s", options.normals ? "on" : "off");
     print_info(", threads ");
-    print_value("%d ", options.threads);
+    print_value("%d", options.threads);
+    if (parameters.viewpoint) {
+      print_info(", viewpoint ");
+      print_value("%g,%g,%g", (*parameters.viewpoint)[0], (*parameters.viewpoint)[1],
+                  (*parameters.viewpoint)[2]);
+    } else if ((cloud.height > 1 || sensor_origin.head<3>() != Eigen::Vector3f::Zero()) &&
+               !options.no_viewpoint) {
+      print_info(", viewpoint ");
+      print_value("%g,%g,%g (sensor origin)", sensor_origin[0], sensor_origin[1], sensor_origin[2]);
+    }
+    print_info(" ");
   }
   timer.tic();
   if (verbose) {
@@ -340,8 +373,10 @@ int run(int argc, char **argv) {
   pcl_ms::Result result;
   const bool reconstructed =
       options.normals
-          ? reconstructAs<pcl::PointNormal>(cloud, parameters, mesh.polygons, result, error)
-          : reconstructAs<pcl::PointXYZ>(cloud, parameters, mesh.polygons, result, error);
+          ? reconstructAs<pcl::PointNormal>(cloud, sensor_origin, parameters, !options.no_viewpoint,
+                                            mesh.polygons, result, error)
+          : reconstructAs<pcl::PointXYZ>(cloud, sensor_origin, parameters, !options.no_viewpoint,
+                                         mesh.polygons, result, error);
   const double reconstruct_ms = timer.toc();
   if (!reconstructed) {
     if (verbose)

@@ -323,6 +323,7 @@ public:
 
     tbb::task_arena arena = detail::threadArena(parameters_.num_threads);
     Clock::time_point stage = Clock::now();
+    surface_.local_scale.assign(points_.size(), 0.0f);
     std::vector<BucketOutcome> leaf_outcomes(leaves.size());
     std::vector<std::size_t> margin_points(leaves.size(), 0);
     arena.execute([&] {
@@ -379,6 +380,10 @@ public:
       }
     }
     surface_.triangles = std::move(nodes[tree_.root()].triangles);
+    // Points of buckets that could not be meshed take the typical scale.
+    for (float &scale : surface_.local_scale)
+      if (!(scale > 0))
+        scale = static_cast<float>(surface_.d_med);
     // Kept triangles may pinch where their neighbours were cut away, and a
     // seam may fail to join two fixed fans at a vertex: bow-ties are possible
     // only at those vertices.
@@ -426,20 +431,39 @@ private:
     outcome = meshBucket(task, parameters_);
     leaf.triangles = toGlobal(outcome.triangles, members);
     markMayPinch(outcome.cut_vertices, members);
+    // Each point's scale is the one its own bucket measured, where its
+    // neighbourhood is complete; seams reuse it. Buckets own disjoint points.
+    if (!outcome.local_scale.empty())
+      for (std::size_t i = 0; i < members.size(); ++i)
+        if (task.core[i])
+          surface_.local_scale[members[i]] = outcome.local_scale[i];
+    outcome.local_scale = {};
     return members.size() - leaf.points.size();
   }
 
-  /// The zone along node's split plane: the subtree's points within d_max
+  /// The zone along node's split plane: the subtree's points within reach
   /// of the plane (core), and points of other subtrees within the margin
-  /// around the node's region. Triangles of the subtree that touch the core
-  /// are fixed; their corners outside the zone are frozen. Returns the
-  /// number of core points.
+  /// around the node's region. A triangle across the plane is shorter than
+  /// rho times the largest local scale near it, so that is the zone's half
+  /// width (at most the margin, beyond which buckets had no context).
+  /// Triangles of the subtree that touch the core are fixed; their corners
+  /// outside the zone are frozen. Returns the number of core points.
   std::size_t stitch(Node &node, BucketOutcome &outcome) {
-    const double half_width = parameters_.rho * surface_.d_med;
-    Box slab = node.region.expanded(margin_);
-    slab.low[node.axis] = std::max(slab.low[node.axis], node.split - half_width);
-    slab.high[node.axis] = std::min(slab.high[node.axis], node.split + half_width);
-    const std::vector<VertexIndex> zone = tree_.gather(slab);
+    auto slabOf = [&](double half_width) {
+      Box slab = node.region.expanded(margin_);
+      slab.low[node.axis] = std::max(slab.low[node.axis], node.split - half_width);
+      slab.high[node.axis] = std::min(slab.high[node.axis], node.split + half_width);
+      return slab;
+    };
+    std::vector<VertexIndex> zone = tree_.gather(slabOf(margin_));
+    float largest_scale = 0;
+    for (VertexIndex v : zone)
+      largest_scale = std::max(largest_scale, surface_.local_scale[v]);
+    const double half_width = std::min(margin_, parameters_.rho * largest_scale);
+    const Box slab = slabOf(half_width);
+    zone.erase(std::remove_if(zone.begin(), zone.end(),
+                              [&](VertexIndex v) { return !slab.contains(points_[v]); }),
+               zone.end());
     // Every triangle of the subtree is tested: a lookup table, not a search.
     std::vector<bool> in_zone(points_.size(), false);
     for (VertexIndex v : zone)
@@ -475,6 +499,9 @@ private:
     if (core_points >= 3) {
       BucketTask task = makeTask(members);
       task.d_med = surface_.d_med;
+      task.local_scale.reserve(members.size());
+      for (VertexIndex v : members)
+        task.local_scale.push_back(surface_.local_scale[v]);
       task.core.resize(members.size());
       task.frozen.resize(members.size());
       for (std::size_t i = 0; i < members.size(); ++i) {
@@ -551,10 +578,12 @@ BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters) {
     options.normals = parameters.use_normals && !task.normals.empty() ? &task.normals : nullptr;
     options.normal_weight = parameters.normal_weight;
     options.d_med = task.d_med;
+    options.local_scale = task.local_scale.empty() ? nullptr : &task.local_scale;
     options.fixed_triangles = task.fixed_triangles.empty() ? nullptr : &task.fixed_triangles;
     options.frozen_vertices = task.frozen.empty() ? nullptr : &task.frozen;
     MedialScaffold scaffold = buildMedialScaffold(task.points, options);
     outcome.d_med = scaffold.d_med;
+    outcome.local_scale = scaffold.local_scale;
     outcome.delaunay_seconds = scaffold.delaunay_seconds;
     outcome.scaffold_seconds = secondsSince(start) - scaffold.delaunay_seconds;
 
@@ -578,6 +607,7 @@ BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters) {
   } catch (const ReconstructionError &error) {
     outcome.error = error.what();
     outcome.triangles.clear();
+    outcome.local_scale.clear();
   }
   return outcome;
 }

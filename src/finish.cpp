@@ -26,6 +26,11 @@ using EdgeKey = std::uint64_t;
 // twist of a real Moebius band, which is kept and reported.
 constexpr double max_untwist_bending = M_PI / 2;
 constexpr int max_untwist_rounds = 3;
+// A twist that an orientation-reversing walk of at most this many triangles
+// closes is a crumple, repaired like a sharp fold.
+constexpr int max_local_twist_steps = 12;
+// Holes of at most this many edges are filled without the size limit.
+constexpr std::size_t max_unlimited_loop_edges = 4;
 // Loops opened by removing a twisted fan are closed again up to this size.
 constexpr int max_untwist_loop_edges = 16;
 
@@ -120,7 +125,8 @@ bool runsFromTo(const Triangle &t, VertexIndex a, VertexIndex b) {
 /// Minimum-cost triangulation of one boundary loop, or nothing.
 std::vector<Triangle> triangulateLoop(const std::vector<VertexIndex> &loop,
                                       const std::vector<Eigen::Vector3d> &points,
-                                      const std::vector<EdgeKey> &mesh_edges, double max_side) {
+                                      const std::vector<EdgeKey> &mesh_edges,
+                                      const SideLimit &limit) {
   using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
   using VertexBase = CGAL::Triangulation_vertex_base_with_info_3<std::size_t, Kernel>;
   using DataStructure = CGAL::Triangulation_data_structure_3<VertexBase>;
@@ -168,10 +174,14 @@ std::vector<Triangle> triangulateLoop(const std::vector<VertexIndex> &loop,
           continue;
         const TriangleShape shape =
             triangleShape(points[loop[i]], points[loop[k]], points[loop[j]]);
-        // A triangular hole takes its one triangle whatever its size; larger
-        // loops keep the greedy's size limit, or fillings would reach across
+        // A hole of three or four edges takes its triangles whatever their
+        // size (a missing triangle or quad between the greedy's triangles,
+        // whose new sides are at most two of its edges long); larger loops
+        // keep the greedy's size limit, or fillings would reach across
         // concave spots.
-        if (shape.compactness <= 0 || (m > 3 && shape.longest_side >= max_side))
+        if (shape.compactness <= 0 ||
+            (m > max_unlimited_loop_edges &&
+             shape.longest_side >= limit.maxSide({loop[i], loop[k], loop[j]})))
           continue;
         const double cost =
             best[i][k] + best[k][j] + shape.perimeter / (shape.compactness * shape.compactness);
@@ -254,8 +264,8 @@ std::vector<std::vector<VertexIndex>> boundaryLoops(const EdgeUses &uses) {
 
 /// fillHoles() given the mesh's boundary loops.
 std::size_t fillLoops(std::vector<Triangle> &triangles, std::vector<std::vector<VertexIndex>> loops,
-                      const std::vector<Eigen::Vector3d> &points, int max_edges, double max_side,
-                      const std::vector<bool> *only_around) {
+                      const std::vector<Eigen::Vector3d> &points, int max_edges,
+                      const SideLimit &limit, const std::vector<bool> *only_around) {
   if (max_edges < 3)
     return 0;
   // Only simple loops: a vertex met twice is a pinch the polygon DP cannot
@@ -302,7 +312,7 @@ std::size_t fillLoops(std::vector<Triangle> &triangles, std::vector<std::vector<
   for (const auto &loop : loops) {
     if (loop.size() < 3 || loop.size() > static_cast<std::size_t>(max_edges))
       continue;
-    std::vector<Triangle> filling = triangulateLoop(loop, points, mesh_edges, max_side);
+    std::vector<Triangle> filling = triangulateLoop(loop, points, mesh_edges, limit);
     bool duplicates_existing = false;
     for (Triangle t : filling) {
       std::sort(t.begin(), t.end());
@@ -328,11 +338,10 @@ std::vector<std::vector<VertexIndex>> traceBoundaryLoops(const std::vector<Trian
 }
 
 std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen::Vector3d> &points,
-                      int max_edges, double max_side, const std::vector<bool> *only_around) {
+                      int max_edges, const SideLimit &limit, const std::vector<bool> *only_around) {
   if (max_edges < 3)
     return 0;
-  return fillLoops(triangles, traceBoundaryLoops(triangles), points, max_edges, max_side,
-                   only_around);
+  return fillLoops(triangles, traceBoundaryLoops(triangles), points, max_edges, limit, only_around);
 }
 
 namespace {
@@ -561,12 +570,41 @@ std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_co
 
 namespace {
 
+/// Whether a walk of at most max_steps triangles from `start` across
+/// manifold pairs returns to it with its orientation reversed (crossing a
+/// pair flagged in `flips` reverses it): breadth first over (triangle,
+/// reversed) states.
+bool reversesWithin(std::uint32_t start, int max_steps, const std::vector<ManifoldPair> &pairs,
+                    const std::vector<std::uint32_t> &offsets,
+                    const std::vector<std::uint32_t> &incident,
+                    const std::vector<std::uint8_t> &flips) {
+  using State = std::pair<std::uint32_t, bool>;
+  std::vector<State> frontier = {{start, false}};
+  std::set<State> seen(frontier.begin(), frontier.end());
+  for (int step = 0; step < max_steps && !frontier.empty(); ++step) {
+    std::vector<State> next;
+    for (const auto &[t, reversed] : frontier)
+      for (std::uint32_t i = offsets[t]; i < offsets[t + 1]; ++i) {
+        const ManifoldPair &pair = pairs[incident[i]];
+        const State state{pair.first == t ? pair.second : pair.first,
+                          reversed != (flips[incident[i]] != 0)};
+        if (state.first == start && state.second)
+          return true;
+        if (seen.insert(state).second)
+          next.push_back(state);
+      }
+    frontier = std::move(next);
+  }
+  return false;
+}
+
 /// orientComponents() given the mesh's manifold pairs.
 std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
                                        const std::vector<ManifoldPair> &pairs,
                                        const std::vector<Eigen::Vector3d> &points,
                                        std::vector<std::uint32_t> &triangle_component,
-                                       std::vector<bool> &component_orientable) {
+                                       std::vector<bool> &component_orientable,
+                                       const Eigen::Vector3d *viewpoint) {
   const std::uint32_t unvisited = std::numeric_limits<std::uint32_t>::max();
   std::vector<std::uint32_t> offsets(triangles.size() + 1, 0);
   for (const ManifoldPair &pair : pairs) {
@@ -635,7 +673,7 @@ std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
   };
   const bool any_twisted = std::find(component_orientable.begin(), component_orientable.end(),
                                      false) != component_orientable.end();
-  std::vector<std::uint32_t> sharply_bent_conflicts;
+  std::vector<std::uint32_t> twisted_spots;
   if (any_twisted) {
     std::vector<double> bending(pairs.size(), 0.0); // in twisted components only
     forEachIndex(pairs.size(), [&](std::size_t p) {
@@ -673,29 +711,41 @@ std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
       if (!component_orientable[triangle_component[t]] && forest.find(t).second)
         std::swap(triangles[t][1], triangles[t][2]);
 
-    std::vector<std::uint8_t> sharp_conflict(pairs.size());
+    std::vector<std::uint8_t> conflict(pairs.size());
     forEachIndex(pairs.size(), [&](std::size_t p) {
-      sharp_conflict[p] =
-          inTwistedComponent(p) && bending[p] > max_untwist_bending &&
-          !consistentlyOriented(triangles[pairs[p].first], triangles[pairs[p].second]);
+      conflict[p] = inTwistedComponent(p) &&
+                    !consistentlyOriented(triangles[pairs[p].first], triangles[pairs[p].second]);
     });
-    for (std::size_t p = 0; p < pairs.size(); ++p)
-      if (sharp_conflict[p])
-        sharply_bent_conflicts.push_back(pairs[p].first);
+    // A conflict is repaired where the surface folds sharply, or where the
+    // twist it closes is local: an orientation-reversing walk of a few
+    // triangles returns to its triangle (a crumple). A real Moebius band
+    // reverses orientation only all the way around (docs/algorithm.md).
+    for (std::uint32_t p = 0; p < pairs.size(); ++p)
+      if (conflict[p] && (viewpoint || bending[p] > max_untwist_bending ||
+                          reversesWithin(pairs[p].first, max_local_twist_steps, pairs, offsets,
+                                         incident, conflict)))
+        twisted_spots.push_back(pairs[p].first);
   }
   for (std::uint32_t component = 0; component < members.size(); ++component) {
     if (!component_orientable[component])
       continue;
-    // Outward for closed surfaces; a fixed, reproducible choice otherwise.
-    double signed_volume = 0;
-    for (std::uint32_t t : members[component])
-      signed_volume +=
-          points[triangles[t][0]].dot(points[triangles[t][1]].cross(points[triangles[t][2]]));
-    if (signed_volume < 0)
+    // Outward for closed surfaces; towards the viewpoint for open ones when
+    // there is one (area-weighted); a fixed, reproducible choice otherwise.
+    double signed_volume = 0, facing = 0;
+    bool closed = true;
+    for (std::uint32_t t : members[component]) {
+      const Eigen::Vector3d &a = points[triangles[t][0]], &b = points[triangles[t][1]],
+                            &c = points[triangles[t][2]];
+      signed_volume += a.dot(b.cross(c));
+      if (viewpoint)
+        facing += (b - a).cross(c - a).dot(*viewpoint - a);
+      closed = closed && offsets[t + 1] - offsets[t] == 3;
+    }
+    if ((viewpoint && !closed ? facing : signed_volume) < 0)
       for (std::uint32_t t : members[component])
         std::swap(triangles[t][1], triangles[t][2]);
   }
-  return sharply_bent_conflicts;
+  return twisted_spots;
 }
 
 } // namespace
@@ -703,9 +753,10 @@ std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
 std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
                                             const std::vector<Eigen::Vector3d> &points,
                                             std::vector<std::uint32_t> &triangle_component,
-                                            std::vector<bool> &component_orientable) {
+                                            std::vector<bool> &component_orientable,
+                                            const Eigen::Vector3d *viewpoint) {
   return orientPairs(triangles, manifoldPairs(edgeUses(triangles)), points, triangle_component,
-                     component_orientable);
+                     component_orientable, viewpoint);
 }
 
 std::size_t removeTwistedFans(std::vector<Triangle> &triangles,
@@ -747,7 +798,8 @@ std::size_t removeTwistedFans(std::vector<Triangle> &triangles,
 
 FinishedSurface finishSurface(std::vector<Triangle> triangles,
                               const std::vector<Eigen::Vector3d> &points, int fill_holes_max_edges,
-                              double max_side, const std::vector<bool> *anchored_vertices) {
+                              const SideLimit &limit, const std::vector<bool> *anchored_vertices,
+                              const Eigen::Vector3d *viewpoint) {
   FinishedSurface surface;
   // Edge uses are built once per set of triangles. Orienting keeps the set,
   // so the boundary loops are traced before it and the uses freed: the
@@ -756,7 +808,7 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
     EdgeUses uses = edgeUses(triangles);
     surface.boundary_loops = boundaryLoops(uses);
     const std::size_t filled =
-        fillLoops(triangles, surface.boundary_loops, points, max_edges, max_side, only_around);
+        fillLoops(triangles, surface.boundary_loops, points, max_edges, limit, only_around);
     if (filled > 0) {
       uses = edgeUses(triangles);
       surface.boundary_loops = boundaryLoops(uses);
@@ -765,7 +817,7 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
     const std::vector<ManifoldPair> pairs = manifoldPairs(uses);
     uses = EdgeUses();
     return orientPairs(triangles, pairs, points, surface.triangle_component,
-                       surface.component_orientable);
+                       surface.component_orientable, viewpoint);
   };
   std::vector<std::uint32_t> twisted = fillThenOrient(fill_holes_max_edges, nullptr);
   for (int round = 0; round < max_untwist_rounds && !twisted.empty(); ++round) {

@@ -664,10 +664,11 @@ private:
 // Point clouds
 
 bool loadPcdCloud(const std::string &path, std::uintmax_t size, pcl::PCLPointCloud2 &cloud,
-                  std::string &error) {
+                  Eigen::Vector4f &sensor_origin, std::string &error) {
   if (!checkPcdHeader(path, size, error))
     return false;
-  if (pcl::io::loadPCDFile(path, cloud) < 0) {
+  Eigen::Quaternionf sensor_orientation;
+  if (pcl::io::loadPCDFile(path, cloud, sensor_origin, sensor_orientation) < 0) {
     error = "PCL's PCD reader rejected the data (corrupt or truncated file)";
     return false;
   }
@@ -1452,8 +1453,10 @@ bool hasNormals(const pcl::PCLPointCloud2 &cloud) {
          isSingleFloatField(findField(cloud, "normal_z"));
 }
 
-bool loadPointCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::string &error) {
+bool loadPointCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::string &error,
+                    Eigen::Vector4f *sensor_origin) {
   cloud = pcl::PCLPointCloud2();
+  Eigen::Vector4f origin = Eigen::Vector4f::Zero();
   std::string reason;
   bool ok = false;
   try {
@@ -1465,7 +1468,7 @@ bool loadPointCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::st
              extension != ".txt")
       reason = unknownFormat(extension, "point cloud", ".pcd, .ply, .xyz or .txt");
     else if (extension == ".pcd")
-      ok = loadPcdCloud(path, size, cloud, reason);
+      ok = loadPcdCloud(path, size, cloud, origin, reason);
     else if (extension == ".ply")
       ok = loadPlyCloud(path, size, cloud, reason);
     else
@@ -1477,8 +1480,11 @@ bool loadPointCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::st
   }
   if (!ok) {
     cloud = pcl::PCLPointCloud2();
+    origin = Eigen::Vector4f::Zero();
     error = path + ": " + reason;
   }
+  if (sensor_origin)
+    *sensor_origin = origin;
   return ok;
 }
 

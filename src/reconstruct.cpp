@@ -27,6 +27,10 @@ std::string Parameters::validate() const {
   else if (fill_holes_max_edges < 0 || fill_holes_max_edges == 1 || fill_holes_max_edges == 2)
     reason << "fill_holes must be 0 (off) or a number of edges >= 3 (got " << fill_holes_max_edges
            << ")";
+  else if (viewpoint && !(std::isfinite((*viewpoint)[0]) && std::isfinite((*viewpoint)[1]) &&
+                          std::isfinite((*viewpoint)[2])))
+    reason << "the viewpoint must be finite (got " << (*viewpoint)[0] << ", " << (*viewpoint)[1]
+           << ", " << (*viewpoint)[2] << ")";
   else if (!(std::isfinite(normal_weight) && normal_weight >= 0))
     reason << "normal weight must be >= 0 (got " << normal_weight << ")";
   else if (!(close_ranking_tolerance >= 0 && close_ranking_tolerance < 1))
@@ -77,6 +81,8 @@ struct PreparedPoints {
   std::vector<Eigen::Vector3d> positions;
   std::vector<Eigen::Vector3f> normals;
   std::vector<VertexIndex> user_index;
+  /// Subtracted from the user's coordinates.
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   /// For each user record, its distinct point (duplicates share one), or
   /// not_prepared for records left out (NaN/Inf, not in the indices). Only
   /// built when asked for: initial triangles need it.
@@ -161,6 +167,7 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
   if (map_records)
     prepared.prepared_of_record.assign(view.size, not_prepared);
   const Eigen::Vector3d centre = 0.5 * (low + high);
+  prepared.centre = centre;
   for (std::size_t i = 0; i < keys.size(); ++i) {
     const Key &key = keys[i];
     if (i > 0 && key.coordinates == keys[i - 1].coordinates) {
@@ -269,10 +276,12 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
       parameters.use_normals ? &prepared.normals : nullptr;
 
   std::vector<Triangle> triangles;
+  std::vector<float> local_scale; // per distinct point
   // Initial triangles are honoured by the one-piece path only.
   if (fixed.empty() && usesBuckets(prepared.positions.size(), parameters)) {
     BucketedSurface bucketed = meshInBuckets(prepared.positions, normals, parameters);
     triangles = std::move(bucketed.triangles);
+    local_scale = std::move(bucketed.local_scale);
     result.d_med = bucketed.d_med;
     result.d_max = parameters.rho * bucketed.d_med;
     result.bucket_statistics = bucketed.statistics;
@@ -305,6 +314,7 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
     GreedyMesher mesher(scaffold, prepared.positions, parameters);
     mesher.run();
     triangles = mesher.triangles();
+    local_scale = std::move(scaffold.local_scale);
     result.pass1 = mesher.statistics().pass1;
     result.pass2 = mesher.statistics().pass2;
     result.cleanup_undone = mesher.statistics().cleanup_undone;
@@ -323,11 +333,17 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
         anchored[v] = true;
   }
   // The finish stage's parallel loops use the threads the user allowed.
+  std::optional<Eigen::Vector3d> viewpoint;
+  if (parameters.viewpoint)
+    viewpoint = Eigen::Vector3d((*parameters.viewpoint)[0], (*parameters.viewpoint)[1],
+                                (*parameters.viewpoint)[2]) -
+                prepared.centre;
   FinishedSurface surface;
   detail::threadArena(parameters.num_threads).execute([&] {
     surface =
         finishSurface(std::move(triangles), prepared.positions, parameters.fill_holes_max_edges,
-                      result.d_max, anchored.empty() ? nullptr : &anchored);
+                      SideLimit{&local_scale, parameters.rho},
+                      anchored.empty() ? nullptr : &anchored, viewpoint ? &*viewpoint : nullptr);
   });
   // Back to the user's records.
   for (Triangle &triangle : surface.triangles)

@@ -38,8 +38,11 @@ using VertexHandle = Delaunay::Vertex_handle;
 // so the output does not depend on how many threads process them.
 constexpr std::size_t cells_per_chunk = 4096;
 
-// Cells sampled to estimate d_med.
-constexpr std::size_t median_sample_cells = 100000;
+// A point's own scale is read where its smallest Gabriel triangles cover
+// this much of a full turn around it (see measureLocalScales).
+constexpr double scale_turn_fraction = 0.25;
+// Rounds of the median over those triangles' corners.
+constexpr int scale_smoothing_rounds = 2;
 
 // A vanishing shock length (co-spherical points) must not divide by zero.
 constexpr double min_shock_length_fraction = 1e-6;
@@ -146,13 +149,16 @@ void forEachChunk(std::size_t items, int num_threads, const ChunkWork &work) {
   detail::threadArena(num_threads).execute(run);
 }
 
-double median(std::vector<float> &values) {
-  if (values.empty())
+/// The median of [first, last), reordering it; 0 when empty.
+template <typename Iterator> float medianOf(Iterator first, Iterator last) {
+  if (first == last)
     return 0;
-  auto middle = values.begin() + values.size() / 2;
-  std::nth_element(values.begin(), middle, values.end());
+  const Iterator middle = first + (last - first) / 2;
+  std::nth_element(first, middle, last);
   return *middle;
 }
+
+double median(std::vector<float> &values) { return medianOf(values.begin(), values.end()); }
 
 /// Per-chunk output of the candidate pass.
 struct ChunkCandidates {
@@ -177,8 +183,7 @@ public:
     scaffold_.planar = delaunay.dimension() == 2;
 
     collectCells(delaunay);
-    scaffold_.d_med = options_.d_med > 0 ? options_.d_med : medianCircumradius(delaunay);
-    scaffold_.d_max = options_.rho * scaffold_.d_med;
+    measureLocalScales(delaunay);
     buildCandidates(delaunay);
     // The tetrahedra are no longer needed: free them before the edge graph.
     cells_.clear();
@@ -238,18 +243,32 @@ private:
     }
   }
 
-  /// d_med: median circumradius of the type I and II triangles (all
-  /// triangles in the planar case, where every Voronoi edge is a line).
-  double medianCircumradius(const Delaunay &delaunay) {
-    // A fixed stride of cells estimates the median as well as all of them.
-    const std::size_t stride = std::max<std::size_t>(1, cells_.size() / median_sample_cells);
-    std::vector<std::vector<float>> chunk_radii(chunkCount(cells_.size()));
+  /// Each point's local scale (docs/algorithm.md, "Local scale"): the
+  /// typical circumradius of the surface triangles where it lies. Points
+  /// given a scale in ScaffoldOptions::local_scale keep it.
+  ///
+  /// 1. A point's own value: its Gabriel triangles (types I and II; all
+  ///    triangles in the planar case), smallest first, until their angles at
+  ///    the point cover a quarter turn; the circumradius reached then. At the
+  ///    rim of a hole, where Gabriel triangles also span the hole, the
+  ///    quarter turn is covered by the surface's own small triangles.
+  /// 2. The scale: the median of the own values of the point and of the
+  ///    corners of the triangles that made up its quarter turn, so that one
+  ///    odd point does not decide; then the same median of these medians.
+  /// 3. One factor for the whole cloud makes the median scale the median
+  ///    Gabriel circumradius, d_med: on a uniform sample every scale is about
+  ///    d_med, and rho keeps the meaning it had with one global length.
+  void measureLocalScales(const Delaunay &delaunay) {
+    const std::size_t n = points_.size();
+    struct GabrielTriangle {
+      std::array<VertexIndex, 3> corners;
+      float circumradius;
+    };
+    std::vector<std::vector<GabrielTriangle>> chunk_triangles(chunkCount(cells_.size()));
     forEachChunk(cells_.size(), options_.num_threads,
                  [&](std::size_t chunk, std::size_t begin, std::size_t end) {
-                   std::vector<float> &radii = chunk_radii[chunk];
-                   for (std::size_t index = begin; index < end; ++index) {
-                     if (index % stride != 0)
-                       continue;
+                   auto &gabriel = chunk_triangles[chunk];
+                   for (std::size_t index = begin; index < end; ++index)
                      forEachOwnedFacet(
                          delaunay, cells_[index],
                          [&](CellHandle cell, int i, const auto &vertices) {
@@ -262,16 +281,115 @@ private:
                            if (!scaffold_.planar && !isGabriel(delaunay, cell, i, vertices, circle,
                                                                triangleShape(p, q, r).compactness))
                              return;
-                           radii.push_back(static_cast<float>(circle.radius));
+                           gabriel.push_back(
+                               {{vertices[0]->info(), vertices[1]->info(), vertices[2]->info()},
+                                static_cast<float>(circle.radius)});
                          });
-                   }
                  });
-    std::vector<float> radii;
-    for (const auto &chunk : chunk_radii)
-      radii.insert(radii.end(), chunk.begin(), chunk.end());
-    if (radii.empty())
+    // Each point's Gabriel triangles (CSR): their circumradii and, two per
+    // triangle, the other corners.
+    std::vector<std::uint32_t> offsets(n + 1, 0);
+    std::vector<float> circumradii;
+    for (const auto &gabriel : chunk_triangles)
+      for (const GabrielTriangle &triangle : gabriel) {
+        circumradii.push_back(triangle.circumradius);
+        for (VertexIndex v : triangle.corners)
+          ++offsets[v + 1];
+      }
+    if (circumradii.empty())
       throw ReconstructionError("all points are collinear: no surface can be built");
-    return median(radii);
+    std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+    std::vector<float> radii_at(offsets[n]);
+    std::vector<VertexIndex> corners_at(2 * std::size_t{offsets[n]});
+    {
+      std::vector<std::uint32_t> cursor(offsets.begin(), offsets.end() - 1);
+      for (auto &gabriel : chunk_triangles) {
+        for (const GabrielTriangle &triangle : gabriel)
+          for (int k = 0; k < 3; ++k) {
+            const std::uint32_t slot = cursor[triangle.corners[k]]++;
+            corners_at[2 * std::size_t{slot}] = triangle.corners[(k + 1) % 3];
+            corners_at[2 * std::size_t{slot} + 1] = triangle.corners[(k + 2) % 3];
+            radii_at[slot] = triangle.circumradius;
+          }
+        gabriel = {};
+      }
+    }
+    auto cornersOf = [&](std::uint32_t slot) {
+      return std::make_pair(corners_at[2 * std::size_t{slot}],
+                            corners_at[2 * std::size_t{slot} + 1]);
+    };
+    // Step 1. 0 marks a point on no Gabriel triangle (rare: each of its
+    // triangles has a neighbour inside its diametral sphere). Ties in size
+    // are broken by angle, so the result does not depend on the order.
+    std::vector<float> own(n, 0.0f);
+    forEachChunk(n, options_.num_threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+      std::vector<std::pair<float, float>> by_size; // (circumradius, angle at the point)
+      for (std::size_t v = begin; v < end; ++v) {
+        by_size.clear();
+        for (std::uint32_t slot = offsets[v]; slot < offsets[v + 1]; ++slot) {
+          const auto [b, c] = cornersOf(slot);
+          const Eigen::Vector3d to_b = points_[b] - points_[v], to_c = points_[c] - points_[v];
+          by_size.emplace_back(radii_at[slot], static_cast<float>(std::atan2(
+                                                   to_b.cross(to_c).norm(), to_b.dot(to_c))));
+        }
+        std::sort(by_size.begin(), by_size.end());
+        double covered = 0;
+        for (const auto &[radius, angle] : by_size) {
+          own[v] = radius;
+          covered += angle;
+          if (covered >= scale_turn_fraction * 2 * M_PI)
+            break;
+        }
+      }
+    });
+    // Step 2, twice: once is not enough to tame the spread of a random
+    // sample's own values, which left holes in the sparse parts of the test
+    // clouds and let one inflated corner stretch a triangle across a depth
+    // jump (docs/algorithm.md).
+    std::vector<float> &scale = scaffold_.local_scale;
+    std::vector<float> previous = own;
+    scale.assign(n, 0.0f);
+    for (int round = 0; round < scale_smoothing_rounds; ++round) {
+      forEachChunk(n, options_.num_threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+        std::vector<float> around;
+        for (std::size_t v = begin; v < end; ++v) {
+          around.clear();
+          if (previous[v] > 0)
+            around.push_back(previous[v]);
+          for (std::uint32_t slot = offsets[v]; slot < offsets[v + 1]; ++slot) {
+            if (radii_at[slot] > own[v])
+              continue; // not one of the triangles of its quarter turn
+            const auto [b, c] = cornersOf(slot);
+            for (VertexIndex corner : {b, c})
+              if (previous[corner] > 0)
+                around.push_back(previous[corner]);
+          }
+          scale[v] = medianOf(around.begin(), around.end());
+        }
+      });
+      previous = scale;
+    }
+    previous = {};
+    radii_at = {};
+    corners_at = {};
+    // Step 3.
+    std::vector<float> measured;
+    measured.reserve(n);
+    for (float value : scale)
+      if (value > 0)
+        measured.push_back(value);
+    const double median_circumradius = median(circumradii);
+    const double median_scale = median(measured);
+    scaffold_.d_med = options_.d_med > 0 ? options_.d_med : median_circumradius;
+    scaffold_.d_max = options_.rho * scaffold_.d_med;
+    const double calibration = median_scale > 0 ? median_circumradius / median_scale : 1.0;
+    for (std::size_t v = 0; v < n; ++v) {
+      if (options_.local_scale && (*options_.local_scale)[v] > 0)
+        scale[v] = (*options_.local_scale)[v];
+      else
+        scale[v] = scale[v] > 0 ? static_cast<float>(scale[v] * calibration)
+                                : static_cast<float>(scaffold_.d_med);
+    }
   }
 
   /// The shorter piece of the dual Voronoi edge cut by the circumcentre.
@@ -304,8 +422,7 @@ private:
 
   void buildCandidates(const Delaunay &delaunay) {
     std::vector<ChunkCandidates> chunks(chunkCount(cells_.size()));
-    const double min_shock_length = min_shock_length_fraction * scaffold_.d_med;
-    const double d_max_squared = scaffold_.d_max * scaffold_.d_max;
+    const std::vector<float> &scale = scaffold_.local_scale;
     forEachChunk(
         cells_.size(), options_.num_threads,
         [&](std::size_t chunk, std::size_t begin, std::size_t end) {
@@ -325,8 +442,10 @@ private:
                                         &c = points_[candidate.vertices[2]];
                   // About half the facets of a surface sample's tetrahedra are
                   // too long: the cheap length test comes first.
+                  const double local_scale = triangleScale(scale, candidate.vertices);
+                  const double max_side = options_.rho * local_scale;
                   if (std::max({(b - a).squaredNorm(), (c - b).squaredNorm(),
-                                (a - c).squaredNorm()}) >= d_max_squared) {
+                                (a - c).squaredNorm()}) >= max_side * max_side) {
                     ++out.oversize;
                     return;
                   }
@@ -341,7 +460,7 @@ private:
                   if (scaffold_.planar) {
                     // Both Voronoi pieces are infinite in a plane: rank by shape and size.
                     candidate.type = CandidateType::acute;
-                    shock_length = scaffold_.d_med;
+                    shock_length = local_scale;
                   } else if (isGabriel(delaunay, cell, i, handles, circle, shape.compactness)) {
                     const bool acute = CGAL::angle(handles[2]->point(), handles[0]->point(),
                                                    handles[1]->point()) == CGAL::ACUTE &&
@@ -352,11 +471,11 @@ private:
                     candidate.type = acute ? CandidateType::acute : CandidateType::obtuse;
                     shock_length = shockLength(delaunay, cell, i, circle);
                   } else {
-                    // Type III has no A1^3-2 point on its curve: use the typical spacing.
+                    // Type III has no A1^3-2 point on its curve: use the local spacing.
                     candidate.type = CandidateType::ambiguous;
-                    shock_length = scaffold_.d_med;
+                    shock_length = local_scale;
                   }
-                  shock_length = std::max(shock_length, min_shock_length);
+                  shock_length = std::max(shock_length, min_shock_length_fraction * local_scale);
                   const double compactness_squared = shape.compactness * shape.compactness;
                   double base_cost = baseCost(shape.perimeter, shock_length, shape.compactness);
                   if (options_.normals)

@@ -367,12 +367,15 @@ TEST(Finish, FillsTheMissingFaceOfACube) {
   // The cube's faces as two triangles each, the top (z = 1) left out.
   const std::vector<Triangle> open_box = {{0, 2, 1}, {1, 2, 3}, {0, 1, 5}, {0, 5, 4}, {1, 3, 7},
                                           {1, 7, 5}, {3, 2, 6}, {3, 6, 7}, {2, 0, 4}, {2, 4, 6}};
-  FinishedSurface kept = finishSurface(open_box, corners, 3, 10.0);
+  const std::vector<float> unit_scale(corners.size(), 1.0f); // sides below rho
+  FinishedSurface kept = finishSurface(open_box, corners, 3, SideLimit{&unit_scale, 10.0});
   EXPECT_EQ(kept.holes_filled, 0u); // the hole has 4 edges, more than 3
   EXPECT_EQ(kept.boundary_loops.size(), 1u);
-  FinishedSurface too_small = finishSurface(open_box, corners, 4, 1.2); // diagonal 1.41
-  EXPECT_EQ(too_small.holes_filled, 0u);
-  FinishedSurface closed = finishSurface(open_box, corners, 4, 10.0);
+  // A hole of four edges is closed whatever the size limit: its filling's
+  // new side is at most two of its edges long.
+  FinishedSurface small_limit = finishSurface(open_box, corners, 4, SideLimit{&unit_scale, 1.2});
+  EXPECT_EQ(small_limit.holes_filled, 1u);
+  FinishedSurface closed = finishSurface(open_box, corners, 4, SideLimit{&unit_scale, 10.0});
   EXPECT_EQ(closed.holes_filled, 1u);
   EXPECT_EQ(closed.triangles.size(), 12u);
   EXPECT_TRUE(closed.boundary_loops.empty());
@@ -380,6 +383,28 @@ TEST(Finish, FillsTheMissingFaceOfACube) {
   expectCleanManifold(report);
   EXPECT_EQ(report.euler_characteristic, 2);
   EXPECT_EQ(report.inconsistently_oriented_edges, 0u);
+}
+
+TEST(Finish, LargerHolesKeepTheLocalSizeLimit) {
+  // A pentagonal cone open at the top: the filling's diagonals are 1.90
+  // times the rim's radius of 1.
+  std::vector<Eigen::Vector3d> points = {{0, 0, 0}};
+  for (int k = 0; k < 5; ++k)
+    points.emplace_back(std::cos(2 * M_PI * k / 5), std::sin(2 * M_PI * k / 5), 1.0);
+  std::vector<Triangle> cone;
+  for (VertexIndex k = 0; k < 5; ++k)
+    cone.push_back({0, 1 + k, 1 + (k + 1) % 5});
+  const std::vector<float> unit_scale(points.size(), 1.0f);
+  const FinishedSurface too_small = finishSurface(cone, points, 8, SideLimit{&unit_scale, 1.8});
+  EXPECT_EQ(too_small.holes_filled, 0u);
+  EXPECT_EQ(too_small.boundary_loops.size(), 1u);
+  // The limit is rho times the local scale of the filling's corners.
+  std::vector<float> sparser_rim(points.size(), 1.2f);
+  sparser_rim[0] = 1.0f;
+  const FinishedSurface closed = finishSurface(cone, points, 8, SideLimit{&sparser_rim, 1.8});
+  EXPECT_EQ(closed.holes_filled, 1u);
+  EXPECT_TRUE(closed.boundary_loops.empty());
+  EXPECT_EQ(closed.triangles.size(), 8u);
 }
 
 TEST(Finish, OrientsClosedSurfacesOutward) {
@@ -403,7 +428,8 @@ TEST(Finish, GentleMoebiusBandIsKeptWhole) {
   std::vector<Eigen::Vector3d> points;
   std::vector<Triangle> band;
   moebiusBand(60, 0.2, points, band);
-  const FinishedSurface surface = finishSurface(band, points, 8, 10.0);
+  const std::vector<float> unit_scale(points.size(), 1.0f);
+  const FinishedSurface surface = finishSurface(band, points, 8, SideLimit{&unit_scale, 10.0});
   EXPECT_EQ(surface.triangles.size(), band.size());
   EXPECT_EQ(surface.twist_triangles_removed, 0u);
   ASSERT_EQ(surface.component_orientable.size(), 1u);
@@ -417,9 +443,12 @@ TEST(Finish, SameSurfaceForAnyNumberOfThreads) {
   std::vector<Eigen::Vector3d> points;
   std::vector<Triangle> band;
   moebiusBand(6000, 0.2, points, band);
+  const std::vector<float> unit_scale(points.size(), 1.0f);
   auto finishWith = [&](int threads) {
     FinishedSurface surface;
-    tbb::task_arena(threads).execute([&] { surface = finishSurface(band, points, 8, 10.0); });
+    tbb::task_arena(threads).execute([&] {
+      surface = finishSurface(band, points, 8, SideLimit{&unit_scale, 10.0});
+    });
     return surface;
   };
   const FinishedSurface one = finishWith(1);

@@ -38,8 +38,11 @@ struct BucketTask {
   std::vector<Triangle> fixed_triangles;
   /// Points that only fixed triangles may use (empty: none).
   std::vector<bool> frozen;
-  /// d_med to use (> 0), or 0 to measure it on these points.
+  /// d_med to report (> 0), or 0 to measure it on these points.
   double d_med = 0;
+  /// Empty, or a local scale per point: entries > 0 are used as they are,
+  /// the others measured here (see ScaffoldOptions::local_scale).
+  std::vector<float> local_scale;
 };
 
 struct BucketOutcome {
@@ -48,6 +51,8 @@ struct BucketOutcome {
   /// not core: where the kept triangles may pinch, ascending.
   std::vector<VertexIndex> cut_vertices;
   double d_med = 0;
+  /// The local scale of each point of the task (empty on error).
+  std::vector<float> local_scale;
   double delaunay_seconds = 0, scaffold_seconds = 0, greedy_seconds = 0;
   /// Not empty when the unit could not be meshed (e.g. collinear points).
   std::string error;
@@ -63,6 +68,8 @@ bool usesBuckets(std::size_t points, const Parameters &parameters);
 struct BucketedSurface {
   std::vector<Triangle> triangles; // indices into the points given
   double d_med = 0;                // median of the buckets' d_med
+  /// Each point's local scale, as measured by the bucket that owns it.
+  std::vector<float> local_scale;
   BucketStatistics statistics;
   // Summed over buckets and seams (thread time).
   double delaunay_seconds = 0, scaffold_seconds = 0, greedy_seconds = 0;

@@ -4,6 +4,7 @@
 // boundary loops traced. Works on a plain 2-manifold triangle list.
 #pragma once
 
+#include <pcl_ms/local_scale.h>
 #include <pcl_ms/types.h>
 
 #include <Eigen/Core>
@@ -28,22 +29,25 @@ std::vector<std::vector<VertexIndex>> traceBoundaryLoops(const std::vector<Trian
 
 /// Closes loops of at most max_edges edges with triangles of the Delaunay
 /// triangulation of the loop's vertices (minimum total P / C^2, no edge
-/// that the mesh already has inside the hole, sides below max_side except
+/// that the mesh already has inside the hole, sides below the limit except
 /// for a triangular hole). Only simple loops; with only_around, only loops
 /// through a vertex marked there. Returns the holes closed.
 std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen::Vector3d> &points,
-                      int max_edges, double max_side,
+                      int max_edges, const SideLimit &limit,
                       const std::vector<bool> *only_around = nullptr);
 
 /// Orients every component consistently, spreading across the flattest
-/// shared edges first (outward for closed components: positive signed
-/// volume); a component where no consistent orientation exists is reported
-/// and kept. Returns one triangle per inconsistent edge that bends by more
-/// than 90 degrees.
+/// shared edges first: outward for closed components (positive signed
+/// volume), towards the viewpoint (when given) for the others. A component
+/// where no consistent orientation exists is reported and kept. Returns one
+/// triangle per inconsistent edge that a repair should cut out: where the
+/// surface folds by more than 90 degrees, where the twist is local (a short
+/// orientation-reversing walk closes it), or anywhere with a viewpoint.
 std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
                                             const std::vector<Eigen::Vector3d> &points,
                                             std::vector<std::uint32_t> &triangle_component,
-                                            std::vector<bool> &component_orientable);
+                                            std::vector<bool> &component_orientable,
+                                            const Eigen::Vector3d *viewpoint = nullptr);
 
 /// At each triangle that orientComponents reported (a sharp twist, e.g. a
 /// crumpled fan around a stray point), removes the most crumpled corner's
@@ -65,7 +69,8 @@ std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_co
 /// All of the above in order.
 FinishedSurface finishSurface(std::vector<Triangle> triangles,
                               const std::vector<Eigen::Vector3d> &points, int fill_holes_max_edges,
-                              double max_side,
-                              const std::vector<bool> *anchored_vertices = nullptr);
+                              const SideLimit &limit,
+                              const std::vector<bool> *anchored_vertices = nullptr,
+                              const Eigen::Vector3d *viewpoint = nullptr);
 
 } // namespace pcl_ms

@@ -28,7 +28,10 @@ std::string fileExtension(const std::string &path);
 ///    nz) per line; blank lines and `#` comments are skipped.
 /// On success `cloud` has FLOAT32 fields x, y, z (plus whatever else the file
 /// holds) and at least one point. On failure `cloud` is left empty.
-bool loadPointCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::string &error);
+/// `sensor_origin`, when given, receives a PCD file's VIEWPOINT position
+/// (zero for the other formats and on failure).
+bool loadPointCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::string &error,
+                    Eigen::Vector4f *sensor_origin = nullptr);
 
 /// Loads a triangle mesh (for instance a reference surface) from .ply, .obj,
 /// .off or legacy .vtk (POLYDATA, ascii or binary). Polygons with more than

@@ -47,9 +47,10 @@ public:
   void reconstruct(pcl::PointCloud<PointInT> &points,
                    std::vector<pcl::Vertices> &polygons) override;
 
-  /** \brief d_max = rho * d_med caps triangle sides, d_med being the median
-   * circumradius of the Gabriel Delaunay triangles (default 5; the paper uses
-   * 5-15, 30 closes the bunny's base holes). Must be > 0. */
+  /** \brief Triangle sides stay below rho times the local scale where the
+   * triangle lies: the typical circumradius of the surface triangles there,
+   * so sparse parts of a cloud get larger triangles than dense ones (default
+   * 5; the paper uses 5-15, 30 closes the bunny's base holes). Must be > 0. */
   void setRho(double rho) { parameters_.rho = rho; }
   double getRho() const { return parameters_.rho; }
 
@@ -107,6 +108,28 @@ public:
   void setGridBuckets(int n) { parameters_.grid_buckets = n; }
   int getGridBuckets() const { return parameters_.grid_buckets; }
 
+  /** \brief Where the cloud was scanned from, in its coordinates: every
+   * component with a boundary is oriented to face it, and twists in it are
+   * repaired (a surface seen from one point is never one-sided). Without it,
+   * the cloud's sensor_origin_ is used when the cloud is organized (a depth
+   * frame) or its sensor origin is not zero, unless setUseSensorOrigin(false). */
+  void setViewpoint(float x, float y, float z) { parameters_.viewpoint = {{x, y, z}}; }
+  /** \brief Forgets a viewpoint given with setViewpoint(). */
+  void clearViewpoint() { parameters_.viewpoint.reset(); }
+  /** \brief False when no viewpoint was given with setViewpoint(). */
+  bool getViewpoint(float &x, float &y, float &z) const {
+    if (!parameters_.viewpoint)
+      return false;
+    x = static_cast<float>((*parameters_.viewpoint)[0]);
+    y = static_cast<float>((*parameters_.viewpoint)[1]);
+    z = static_cast<float>((*parameters_.viewpoint)[2]);
+    return true;
+  }
+  /** \brief Whether an organized cloud's or a non-zero sensor_origin_ serves
+   * as the viewpoint when none was set (default true). */
+  void setUseSensorOrigin(bool use) { use_sensor_origin_ = use; }
+  bool getUseSensorOrigin() const { return use_sensor_origin_; }
+
   /** \brief Triangles (indices into the input cloud) that are part of the
    * surface from the start; the method completes the mesh around them
    * (default: none). They must be edge-manifold and use valid points. */
@@ -139,6 +162,7 @@ private:
   bool runCore(std::vector<pcl::Vertices> &polygons);
 
   pcl_ms::Parameters parameters_;
+  bool use_sensor_origin_ = true;
   NormalCloud::ConstPtr normals_;
   std::vector<pcl::Vertices> initial_triangles_;
   pcl_ms::Result result_;

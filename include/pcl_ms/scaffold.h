@@ -4,6 +4,7 @@
 // A1^3 shock curve) and is a candidate surface triangle.
 #pragma once
 
+#include <pcl_ms/local_scale.h>
 #include <pcl_ms/types.h>
 
 #include <Eigen/Core>
@@ -60,11 +61,15 @@ struct MedialScaffold {
   /// The candidates of ScaffoldOptions::fixed_triangles, in the same order.
   std::vector<CandidateIndex> fixed;
 
-  double d_med = 0; // median circumradius of type I and II triangles
-  double d_max = 0; // rho * d_med
+  /// Each point's local scale: the median circumradius of the type I and
+  /// II triangles at it. A candidate's sides stay below rho times
+  /// triangleScale() of its corners.
+  std::vector<float> local_scale;
+  double d_med = 0; // median of the local scales (a summary)
+  double d_max = 0; // rho * d_med (a summary)
   bool planar = false;
   std::size_t type1 = 0, type2 = 0, type3 = 0;
-  std::size_t oversize = 0;   // longest side >= d_max: never queued
+  std::size_t oversize = 0;   // longest side >= rho * local scale: never queued
   std::size_t degenerate = 0; // collinear generators: never queued
   double delaunay_seconds = 0;
 
@@ -96,9 +101,13 @@ struct ScaffoldOptions {
   /// Optional unit normals per point (same indexing as points) and kappa.
   const std::vector<Eigen::Vector3f> *normals = nullptr;
   double normal_weight = 1.0;
-  /// d_med to use instead of measuring it (> 0): the buckets and seams of
-  /// one cloud share one value, so they agree on d_max.
+  /// d_med to report instead of measuring it (> 0): the buckets and seams
+  /// of one cloud share one value.
   double d_med = 0;
+  /// Optional local scale per point (same indexing as points): entries > 0
+  /// are used as they are instead of being measured here, so that seams
+  /// judge their points as the buckets that own them did.
+  const std::vector<float> *local_scale = nullptr;
   /// Triangles already in the surface (partial re-meshing, stitching). Each
   /// becomes a candidate even when it is not a Delaunay triangle of these
   /// points or is longer than d_max; the greedy keeps them all.

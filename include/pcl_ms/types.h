@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,9 +30,11 @@ struct PointView {
   const std::vector<int> *indices = nullptr;
 };
 
-/// All tuning knobs of the method; defaults follow ALGORITHM.md.
+/// All tuning knobs of the method (docs/algorithm.md).
 struct Parameters {
-  /// d_max = rho * d_med: candidates with a side >= d_max are never queued.
+  /// Candidates with a side >= rho times their local scale (the typical
+  /// circumradius of the surface triangles where they lie; on a uniform
+  /// sample about d_med) are never queued.
   /// 5, the low end of the paper's 5-15: on the Stanford bunny, 10 already
   /// bridges the two large base holes that the paper leaves open (1.5 % of
   /// the diagonal off the reference surface, against 0.5 % at 5, same recall).
@@ -40,6 +43,11 @@ struct Parameters {
   /// leaves a few tiny loops where its vertex rules refused the last
   /// triangle; 8 closes them on the bunny and leaves real openings alone.
   int fill_holes_max_edges = 8;
+  /// Where a one-view scan was taken from (the cloud's coordinates): every
+  /// component that has a boundary is then oriented to face it, and any
+  /// twist in it is repaired, since a surface seen from one point is never
+  /// one-sided. Closed components stay oriented outward.
+  std::optional<std::array<double, 3>> viewpoint;
   /// Use the input normals to prefer candidates aligned with them.
   bool use_normals = false;
   /// kappa in eps1 * (1 + kappa (1 - mean |n_T . n_v|)).
@@ -132,6 +140,8 @@ struct Result {
 
   std::size_t candidates_type1 = 0, candidates_type2 = 0, candidates_type3 = 0;
   std::size_t candidates_oversize = 0;
+  /// Summaries: the median Gabriel circumradius and rho times it. The size
+  /// limit itself is local (Parameters::rho).
   double d_med = 0, d_max = 0;
   PassStatistics pass1, pass2;
   std::size_t cleanup_undone = 0; // flaps/isolated triangles and final sweep

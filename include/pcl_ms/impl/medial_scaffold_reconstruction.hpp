@@ -104,8 +104,14 @@ bool MedialScaffoldReconstruction<PointInT>::runCore(std::vector<pcl::Vertices> 
                        static_cast<pcl_ms::VertexIndex>(vertices[2])});
   }
 
+  pcl_ms::Parameters parameters = parameters_;
+  const Eigen::Vector4f &origin = input_->sensor_origin_;
+  if (!parameters.viewpoint && use_sensor_origin_ &&
+      (input_->isOrganized() || origin.head<3>() != Eigen::Vector3f::Zero()))
+    parameters.viewpoint = {{origin[0], origin[1], origin[2]}};
+
   try {
-    result_ = pcl_ms::reconstruct(view, parameters_, initial);
+    result_ = pcl_ms::reconstruct(view, parameters, initial);
   } catch (const pcl_ms::ReconstructionError &error) {
     error_message_ = error.what();
     PCL_ERROR("[pcl::%s::reconstruct] %s\n", getClassName().c_str(), error_message_.c_str());

@@ -1,0 +1,186 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The local scale and the viewpoint (docs/algorithm.md, "Local scale" and
+// "Orientation"): clouds whose density varies by an order of magnitude are
+// meshed with their true topology, and one-view scans face their sensor.
+#include "test_support.h"
+
+#include <pcl_ms/medial_scaffold_reconstruction.h>
+#include <pcl_ms/scaffold.h>
+
+#include "synthetic_clouds.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace {
+
+using pcl_ms::MeshTopologyReport;
+using pcl_ms::Triangle;
+using pcl_ms_test::expectCleanManifold;
+using pcl_ms_test::positions;
+using pcl_ms_test::viewOf;
+
+struct Meshed {
+  pcl_ms::Result result;
+  MeshTopologyReport topology;
+};
+
+Meshed meshWithDefaults(const pcl::PointCloud<pcl::PointXYZ> &cloud,
+                        const pcl_ms::Parameters &parameters = {}) {
+  Meshed meshed;
+  meshed.result = pcl_ms::reconstruct(viewOf(cloud), parameters);
+  meshed.topology = pcl_ms::analyzeMesh(positions(cloud), meshed.result.triangles);
+  return meshed;
+}
+
+void expectTopology(const pcl_ms_tools::SyntheticCloud &synthetic, const Meshed &meshed) {
+  SCOPED_TRACE(synthetic.name);
+  expectCleanManifold(meshed.topology);
+  EXPECT_EQ(meshed.topology.components, synthetic.truth.components);
+  EXPECT_EQ(meshed.topology.boundary_loops, synthetic.truth.boundary_loops);
+  EXPECT_EQ(meshed.topology.euler_characteristic, synthetic.truth.euler_characteristic);
+  EXPECT_EQ(meshed.topology.orientable, synthetic.truth.orientable);
+  EXPECT_EQ(meshed.topology.inconsistently_oriented_edges, 0u);
+}
+
+TEST(LocalScale, SphereWithDensityFalling25Fold) {
+  const auto sphere = pcl_ms_tools::sphereWithDensityGradient();
+  expectTopology(sphere, meshWithDefaults(sphere.cloud));
+}
+
+TEST(LocalScale, TorusInBandsOfNinefoldDensity) {
+  const auto torus = pcl_ms_tools::torusWithDensityBands();
+  expectTopology(torus, meshWithDefaults(torus.cloud));
+}
+
+TEST(LocalScale, AnnulusKeepsItsHoleAtTenfoldDensity) {
+  // Planar (2-D Delaunay) and near-planar (3-D) versions of the same points.
+  for (double noise : {0.0, 2e-4}) {
+    const auto annulus =
+        pcl_ms_tools::annulusWithDensityGradient(6000, 10, pcl_ms_tools::kSyntheticSeed, noise);
+    const Meshed meshed = meshWithDefaults(annulus.cloud);
+    EXPECT_EQ(meshed.result.planar, noise == 0);
+    expectTopology(annulus, meshed);
+  }
+}
+
+TEST(LocalScale, HemisphereWithDensityRising16FoldToTheRim) {
+  const auto hemisphere = pcl_ms_tools::hemisphereWithDensityGradient();
+  expectTopology(hemisphere, meshWithDefaults(hemisphere.cloud));
+}
+
+TEST(LocalScale, FollowsTheDensity) {
+  // On the sphere the spacing grows 5-fold (sqrt 25) from the dense pole to
+  // the sparse one; the median scale is d_med.
+  const auto sphere = pcl_ms_tools::sphereWithDensityGradient();
+  const std::vector<Eigen::Vector3d> points = positions(sphere.cloud);
+  const pcl_ms::MedialScaffold scaffold = pcl_ms::buildMedialScaffold(points, {});
+  ASSERT_EQ(scaffold.local_scale.size(), points.size());
+  std::vector<float> dense, sparse, all = scaffold.local_scale;
+  for (std::size_t v = 0; v < points.size(); ++v) {
+    if (points[v].z() > 0.8)
+      dense.push_back(scaffold.local_scale[v]);
+    else if (points[v].z() < -0.8)
+      sparse.push_back(scaffold.local_scale[v]);
+  }
+  auto median = [](std::vector<float> values) {
+    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+    return values[values.size() / 2];
+  };
+  ASSERT_FALSE(dense.empty());
+  ASSERT_FALSE(sparse.empty());
+  const double ratio = median(sparse) / median(dense);
+  // The caps span z in [0.8, 1]: density ratios of about 25^0.9 between them.
+  EXPECT_GT(ratio, 3.0);
+  EXPECT_LT(ratio, 6.0);
+  EXPECT_NEAR(median(all), scaffold.d_med, 1e-6 * scaffold.d_med);
+}
+
+/// Share of triangles whose normal (right-hand rule) points to `viewpoint`.
+double facingShare(const std::vector<Eigen::Vector3d> &points,
+                   const std::vector<Triangle> &triangles, const Eigen::Vector3d &viewpoint) {
+  std::size_t facing = 0;
+  for (const Triangle &t : triangles) {
+    const Eigen::Vector3d &a = points[t[0]], &b = points[t[1]], &c = points[t[2]];
+    facing += (b - a).cross(c - a).dot(viewpoint - (a + b + c) / 3) > 0;
+  }
+  return triangles.empty() ? 0 : static_cast<double>(facing) / triangles.size();
+}
+
+pcl_ms::Result meshScan(const pcl_ms_tools::SyntheticScan &scan, bool use_sensor_origin = true) {
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>(scan.cloud);
+  pcl::MedialScaffoldReconstruction<pcl::PointXYZ> reconstruction;
+  reconstruction.setInputCloud(cloud);
+  reconstruction.setUseSensorOrigin(use_sensor_origin);
+  pcl::PolygonMesh mesh;
+  reconstruction.reconstruct(mesh);
+  EXPECT_EQ(reconstruction.getErrorMessage(), "");
+  return reconstruction.getResult();
+}
+
+TEST(Viewpoint, OneViewScanFacesItsSensorAndKeepsTheDepthJumpOpen) {
+  const auto scan = pcl_ms_tools::oneViewScanOfBoxOnPlane();
+  ASSERT_TRUE(scan.cloud.isOrganized());
+  const pcl_ms::Result result = meshScan(scan);
+  const std::vector<Eigen::Vector3d> points = positions(scan.cloud);
+  const MeshTopologyReport topology = pcl_ms::analyzeMesh(points, result.triangles);
+  expectCleanManifold(topology);
+  EXPECT_EQ(topology.components, scan.truth.components);
+  EXPECT_EQ(topology.boundary_loops, scan.truth.boundary_loops);
+  EXPECT_EQ(topology.euler_characteristic, scan.truth.euler_characteristic);
+  EXPECT_TRUE(topology.orientable);
+  const Eigen::Vector3d sensor = scan.scene.sensor.cast<double>();
+  EXPECT_GE(facingShare(points, result.triangles, sensor), 0.999);
+  // No triangle bridges the jump from the box to the ground behind it: each
+  // stays within 10 pixel footprints (range / focal length) of its range,
+  // allowing for grazing incidence.
+  for (const Triangle &t : result.triangles) {
+    const Eigen::Vector3d centroid = (points[t[0]] + points[t[1]] + points[t[2]]) / 3;
+    const double footprint = (centroid - sensor).norm() / scan.focal_length_px;
+    for (int k = 0; k < 3; ++k)
+      ASSERT_LT((points[t[k]] - points[t[(k + 1) % 3]]).norm(), 10 * 4 * footprint)
+          << "triangle " << t[0] << " " << t[1] << " " << t[2];
+  }
+}
+
+TEST(Viewpoint, NoisyScanIsOrientableAndMostlyFacesItsSensor) {
+  const auto scan =
+      pcl_ms_tools::oneViewScanOfBoxOnPlane(160, 120, pcl_ms_tools::kSyntheticSeed, 0.0015);
+  const pcl_ms::Result result = meshScan(scan);
+  const std::vector<Eigen::Vector3d> points = positions(scan.cloud);
+  const MeshTopologyReport topology = pcl_ms::analyzeMesh(points, result.triangles);
+  expectCleanManifold(topology);
+  EXPECT_EQ(result.numberOfNonOrientableComponents(), 0u);
+  EXPECT_TRUE(topology.orientable);
+  EXPECT_EQ(topology.inconsistently_oriented_edges, 0u);
+  // Range noise folds some triangles at the far end; the surface as a whole
+  // faces the sensor.
+  EXPECT_GE(facingShare(points, result.triangles, scan.scene.sensor.cast<double>()), 0.9);
+  // Without the viewpoint the same scan keeps a one-sided piece: this is
+  // what the viewpoint repairs.
+  const pcl_ms::Result without = meshScan(scan, false);
+  EXPECT_GT(without.numberOfNonOrientableComponents(), 0u);
+}
+
+TEST(Viewpoint, ExplicitViewpointWinsAndIsValidated) {
+  const auto scan = pcl_ms_tools::oneViewScanOfBoxOnPlane();
+  pcl_ms::Parameters parameters;
+  // Seen from below the ground, the open surface turns its back to the sensor.
+  parameters.viewpoint = {{0.0, 0.0, -5.0}};
+  const pcl_ms::Result result = pcl_ms::reconstruct(viewOf(scan.cloud), parameters);
+  const std::vector<Eigen::Vector3d> points = positions(scan.cloud);
+  EXPECT_LE(facingShare(points, result.triangles, scan.scene.sensor.cast<double>()), 0.01);
+  parameters.viewpoint = {{0.0, std::nan(""), 1.0}};
+  EXPECT_THROW(pcl_ms::reconstruct(viewOf(scan.cloud), parameters), pcl_ms::ReconstructionError);
+}
+
+TEST(Viewpoint, ClosedSurfacesStayOutward) {
+  // A viewpoint inside the sphere must not turn it inside out.
+  const auto sphere = pcl_ms_tools::sphereWithDensityGradient();
+  pcl_ms::Parameters parameters;
+  parameters.viewpoint = {{0.0, 0.0, 0.0}};
+  const pcl_ms::Result result = pcl_ms::reconstruct(viewOf(sphere.cloud), parameters);
+  EXPECT_LE(facingShare(positions(sphere.cloud), result.triangles, Eigen::Vector3d::Zero()), 0.001);
+}
+
+} // namespace
