@@ -12,10 +12,16 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <visualization_msgs/Marker.h>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <exception>
+#include <string>
+#include <vector>
 
 namespace pcl_ms {
 
@@ -25,8 +31,11 @@ private:
 
   void onInit() override;
   void readParameters(ros::NodeHandle &private_node);
+  void readViewpoint(ros::NodeHandle &private_node);
   void cloudCallback(const sensor_msgs::PointCloud2ConstPtr &message);
-  void meshAndPublish(const sensor_msgs::PointCloud2 &message, Clock::time_point received);
+  /// True when meshed; `report` is the line to log either way.
+  bool meshAndPublish(const sensor_msgs::PointCloud2 &message, Clock::time_point received,
+                      std::string &report);
   void publishMarkers(const std_msgs::Header &header, const pcl::PCLPointCloud2 &cloud,
                       const ros_bridge::MeshingOutcome &outcome);
 
@@ -98,6 +107,7 @@ void MedialScaffoldReconstructionNodelet::readParameters(ros::NodeHandle &privat
   }
   parameters_.bucket_points = static_cast<std::size_t>(bucket_points);
   private_node.param("grid", parameters_.grid_buckets, parameters_.grid_buckets);
+  readViewpoint(private_node);
   private_node.param("queue_size", queue_size_, queue_size_);
   if (queue_size_ < 1) {
     NODELET_ERROR("parameter queue_size must be >= 1 (got %d): using 1", queue_size_);
@@ -105,6 +115,22 @@ void MedialScaffoldReconstructionNodelet::readParameters(ros::NodeHandle &privat
   }
   private_node.param("latch", latch_, latch_);
   private_node.param("skip_if_busy", skip_if_busy_, skip_if_busy_);
+}
+
+void MedialScaffoldReconstructionNodelet::readViewpoint(ros::NodeHandle &private_node) {
+  // Without the parameter the library takes the cloud's sensor origin for
+  // organized clouds; a PointCloud2 carries none, so that is the frame's origin.
+  if (!private_node.hasParam("viewpoint"))
+    return;
+  std::vector<double> viewpoint;
+  if (!private_node.getParam("viewpoint", viewpoint) || viewpoint.size() != 3 ||
+      !std::all_of(viewpoint.begin(), viewpoint.end(),
+                   [](double coordinate) { return std::isfinite(coordinate); })) {
+    NODELET_ERROR("parameter viewpoint must be a list of three numbers [x, y, z] in the cloud's "
+                  "frame: ignored");
+    return;
+  }
+  parameters_.viewpoint = std::array<double, 3>{viewpoint[0], viewpoint[1], viewpoint[2]};
 }
 
 void MedialScaffoldReconstructionNodelet::onInit() {
@@ -134,15 +160,20 @@ void MedialScaffoldReconstructionNodelet::onInit() {
   cloud_subscriber_ =
       skip_if_busy_ ? getMTNodeHandle().subscribe(options) : node.subscribe(options);
 
-  NODELET_INFO("meshing clouds from %s into %s, %s and %s (rho %g, fill_holes %d, use_normals "
-               "%s, threads %d, bucket_points %zu, grid %d, queue_size %d, latch %s, "
-               "skip_if_busy %s)",
-               cloud_subscriber_.getTopic().c_str(), mesh_publisher_.getTopic().c_str(),
-               mesh_marker_publisher_.getTopic().c_str(),
-               boundary_marker_publisher_.getTopic().c_str(), parameters_.rho,
-               parameters_.fill_holes_max_edges, parameters_.use_normals ? "true" : "false",
-               parameters_.num_threads, parameters_.bucket_points, parameters_.grid_buckets,
-               queue_size_, latch_ ? "true" : "false", skip_if_busy_ ? "true" : "false");
+  std::string viewpoint = "the frame's origin for organized clouds";
+  if (parameters_.viewpoint)
+    viewpoint = "[" + std::to_string((*parameters_.viewpoint)[0]) + ", " +
+                std::to_string((*parameters_.viewpoint)[1]) + ", " +
+                std::to_string((*parameters_.viewpoint)[2]) + "]";
+  NODELET_INFO(
+      "meshing clouds from %s into %s, %s and %s (rho %g, fill_holes %d, use_normals "
+      "%s, threads %d, bucket_points %zu, grid %d, viewpoint %s, queue_size %d, latch "
+      "%s, skip_if_busy %s)",
+      cloud_subscriber_.getTopic().c_str(), mesh_publisher_.getTopic().c_str(),
+      mesh_marker_publisher_.getTopic().c_str(), boundary_marker_publisher_.getTopic().c_str(),
+      parameters_.rho, parameters_.fill_holes_max_edges, parameters_.use_normals ? "true" : "false",
+      parameters_.num_threads, parameters_.bucket_points, parameters_.grid_buckets,
+      viewpoint.c_str(), queue_size_, latch_ ? "true" : "false", skip_if_busy_ ? "true" : "false");
 }
 
 void MedialScaffoldReconstructionNodelet::cloudCallback(
@@ -156,27 +187,38 @@ void MedialScaffoldReconstructionNodelet::cloudCallback(
                           message->header.stamp.toSec(), message->header.frame_id.c_str(), dropped);
     return;
   }
+  std::string report;
+  bool meshed = false;
   try {
-    meshAndPublish(*message, received);
+    meshed = meshAndPublish(*message, received, report);
   } catch (const std::exception &error) {
     // Say, out of memory copying a huge cloud: that cloud is lost, not the node.
-    NODELET_ERROR("cloud of %.3f s (frame '%s') not meshed: %s", message->header.stamp.toSec(),
-                  message->header.frame_id.c_str(), error.what());
+    report = "cloud of " + std::to_string(message->header.stamp.toSec()) + " s (frame '" +
+             message->header.frame_id + "') not meshed: " + error.what();
   }
+  // Free before the line is logged: whoever reads it may send the next cloud.
   busy_ = false;
+  if (meshed)
+    NODELET_INFO("%s", report.c_str());
+  else
+    NODELET_ERROR("%s", report.c_str());
 }
 
-void MedialScaffoldReconstructionNodelet::meshAndPublish(const sensor_msgs::PointCloud2 &message,
-                                                         Clock::time_point received) {
+bool MedialScaffoldReconstructionNodelet::meshAndPublish(const sensor_msgs::PointCloud2 &message,
+                                                         Clock::time_point received,
+                                                         std::string &report) {
   pcl::PCLPointCloud2 cloud;
   pcl_conversions::toPCL(message, cloud);
   const ros_bridge::MeshingOutcome outcome = ros_bridge::meshCloud(cloud, parameters_);
   const std::size_t point_count = static_cast<std::size_t>(message.width) * message.height;
+  char line[512];
   if (!outcome.error.empty()) {
-    NODELET_ERROR("cloud of %.3f s (frame '%s', %ux%u = %zu points) not meshed: %s",
+    std::snprintf(line, sizeof line,
+                  "cloud of %.3f s (frame '%s', %ux%u = %zu points) not meshed: ",
                   message.header.stamp.toSec(), message.header.frame_id.c_str(), message.width,
-                  message.height, point_count, outcome.error.c_str());
-    return;
+                  message.height, point_count);
+    report = line + outcome.error;
+    return false;
   }
   if (!outcome.warning.empty())
     NODELET_WARN_ONCE("%s", outcome.warning.c_str());
@@ -196,13 +238,16 @@ void MedialScaffoldReconstructionNodelet::meshAndPublish(const sensor_msgs::Poin
   const Clock::time_point markers_published = Clock::now();
 
   const double to_mesh = secondsBetween(received, mesh_published);
-  NODELET_INFO("cloud %ux%u (%zu points, %zu finite), frame '%s': %zu triangles, %zu boundary "
-               "loops; mesh published %.3f s after receipt (library %.3f s, conversion and "
-               "publishing %.3f s), markers %.3f s",
-               message.width, message.height, point_count, outcome.finite_points,
-               message.header.frame_id.c_str(), outcome.polygons.size(),
-               outcome.boundary_loops.size(), to_mesh, outcome.library_seconds,
-               to_mesh - outcome.library_seconds, secondsBetween(received, markers_published));
+  std::snprintf(line, sizeof line,
+                "cloud %ux%u (%zu points, %zu finite), frame '%s': %zu triangles, %zu boundary "
+                "loops; mesh published %.3f s after receipt (library %.3f s, conversion and "
+                "publishing %.3f s), markers %.3f s",
+                message.width, message.height, point_count, outcome.finite_points,
+                message.header.frame_id.c_str(), outcome.polygons.size(),
+                outcome.boundary_loops.size(), to_mesh, outcome.library_seconds,
+                to_mesh - outcome.library_seconds, secondsBetween(received, markers_published));
+  report = line;
+  return true;
 }
 
 void MedialScaffoldReconstructionNodelet::publishMarkers(

@@ -103,6 +103,11 @@ class MeshNodeTest(unittest.TestCase):
         cls.received = {'mesh': [], 'mesh_marker': [], 'boundary_marker': []}
         cls.errors = []
         cls.drop_warnings = []
+        # Clouds sent, and clouds the node reported done (meshed or refused):
+        # it logs after it is free for the next, so waiting for the report
+        # keeps skip_if_busy from dropping a cloud the test did not mean to.
+        cls.sent = 0
+        cls.finished = 0
         cls.skip_if_busy = rospy.get_param('~skip_if_busy')
         cls.publisher = rospy.Publisher(rospy.get_param('~input'), PointCloud2, queue_size=10)
         rospy.Subscriber(cls.namespace + '/mesh', PolygonMesh, cls.on_message, 'mesh')
@@ -126,8 +131,11 @@ class MeshNodeTest(unittest.TestCase):
     @classmethod
     def on_log(cls, log):
         with cls.lock:
-            if log.level >= Log.ERROR and 'not meshed' in log.msg:
+            if log.level == Log.INFO and 'mesh published' in log.msg:
+                cls.finished += 1
+            elif log.level >= Log.ERROR and 'not meshed' in log.msg:
                 cls.errors.append(log.msg)
+                cls.finished += 1
             elif log.level == Log.WARN and 'skip_if_busy: dropped' in log.msg:
                 cls.drop_warnings.append(log.msg)
             cls.lock.notify_all()
@@ -142,8 +150,17 @@ class MeshNodeTest(unittest.TestCase):
         self.assertIsNotNone(message, 'no %s for the cloud of %s' % (topic, stamp.to_sec()))
         return message
 
-    def mesh_cloud(self, cloud):
+    def publish(self, cloud):
+        """Sends cloud once the node has reported on every earlier one."""
+        with self.lock:
+            self.lock.wait_for(lambda: self.finished >= self.sent or rospy.is_shutdown(),
+                               MESH_TIMEOUT)
+            self.assertGreaterEqual(self.finished, self.sent, 'the node went silent')
+            self.sent += 1
         self.publisher.publish(cloud)
+
+    def mesh_cloud(self, cloud):
+        self.publish(cloud)
         stamp = cloud.header.stamp
         return (self.wait_for('mesh', stamp), self.wait_for('mesh_marker', stamp),
                 self.wait_for('boundary_marker', stamp))
@@ -193,6 +210,21 @@ class MeshNodeTest(unittest.TestCase):
         self.assertGreater(len(mesh.polygons), 1.5 * sum(finite))
         self.assertGreaterEqual(len(boundary_marker.points), 2 * 3)
         self.assertEqual(len(mesh_marker.colors), len(mesh_marker.points))
+        # The surface faces the viewpoint: the parameter when the .test sets
+        # one, else the camera frame's origin (organized cloud). A few
+        # triangles on steep slopes face away from any one point.
+        viewpoint = rospy.get_param('~viewpoint', [0.0, 0.0, 0.0])
+        facing = 0
+        for polygon in mesh.polygons:
+            a, b, c = (points[i] for i in polygon.vertices)
+            ab = [b[k] - a[k] for k in range(3)]
+            ac = [c[k] - a[k] for k in range(3)]
+            normal = [ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2],
+                      ab[0] * ac[1] - ab[1] * ac[0]]
+            to_triangle = [(a[k] + b[k] + c[k]) / 3 - viewpoint[k] for k in range(3)]
+            facing += sum(normal[k] * to_triangle[k] for k in range(3)) < 0
+        self.assertGreater(facing, 0.95 * len(mesh.polygons),
+                           'triangles facing the viewpoint %s' % viewpoint)
         for t, polygon in enumerate(mesh.polygons):
             for corner, index in enumerate(polygon.vertices):
                 self.assertTrue(finite[index], 'triangle %d uses NaN pixel %d' % (t, index))
@@ -217,7 +249,7 @@ class MeshNodeTest(unittest.TestCase):
         for cloud, reason in cases:
             with self.lock:
                 errors_before = len(self.errors)
-            self.publisher.publish(cloud)
+            self.publish(cloud)
             with self.lock:
                 self.lock.wait_for(lambda: len(self.errors) > errors_before, ERROR_TIMEOUT)
                 new_errors = self.errors[errors_before:]
@@ -245,9 +277,9 @@ class MeshNodeTest(unittest.TestCase):
         points, colors = organized_frame()
         frame = make_cloud(points, 'camera_frame', rospy.Time(3002), width=64, height=48,
                            colors=colors)
-        self.publisher.publish(bunny)
+        self.publish(bunny)
         rospy.sleep(0.2)  # the bunny takes about a second: the frame arrives meanwhile
-        self.publisher.publish(frame)
+        self.publisher.publish(frame)  # on purpose without waiting
         self.wait_for('mesh', bunny.header.stamp)
         if self.skip_if_busy:
             with self.lock:

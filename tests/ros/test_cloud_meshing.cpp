@@ -196,6 +196,45 @@ TEST(RosBridgeMeshing, OrganizedFrameWithNaNsIndexesOnlyFinitePoints) {
   }
 }
 
+// How many triangles face `viewpoint` (normal towards it, by winding).
+static std::size_t countFacing(const pcl::PCLPointCloud2 &cloud,
+                               const std::vector<pcl::Vertices> &polygons,
+                               const std::array<float, 3> &viewpoint) {
+  const MarkerGeometry corners = triangleListGeometry(cloud, polygons);
+  std::size_t facing = 0;
+  for (std::size_t t = 0; 3 * t + 2 < corners.points.size(); ++t) {
+    const auto &a = corners.points[3 * t], &b = corners.points[3 * t + 1],
+               &c = corners.points[3 * t + 2];
+    const float ab[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const float ac[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const float normal[3] = {ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2],
+                             ab[0] * ac[1] - ab[1] * ac[0]};
+    float dot = 0;
+    for (int k = 0; k < 3; ++k)
+      dot += normal[k] * (a[k] - viewpoint[k]);
+    facing += dot < 0 ? 1 : 0;
+  }
+  return facing;
+}
+
+TEST(RosBridgeMeshing, OrganizedFrameFacesItsOriginOrTheGivenViewpoint) {
+  const pcl::PCLPointCloud2 frame = makeOrganizedFrame();
+  // A PointCloud2 has no sensor origin: the frame's origin stands for it.
+  const MeshingOutcome from_origin = meshCloud(frame, pcl_ms::Parameters());
+  ASSERT_EQ(from_origin.error, "");
+  // A few triangles on steep slopes face away from any one point; the
+  // orientation's sign shows in the rest.
+  EXPECT_GT(countFacing(frame, from_origin.polygons, {0, 0, 0}),
+            from_origin.polygons.size() * 95 / 100);
+
+  pcl_ms::Parameters behind;
+  behind.viewpoint = std::array<double, 3>{0.0, 0.0, 5.0};
+  const MeshingOutcome from_behind = meshCloud(frame, behind);
+  ASSERT_EQ(from_behind.error, "");
+  EXPECT_GT(countFacing(frame, from_behind.polygons, {0, 0, 5}),
+            from_behind.polygons.size() * 95 / 100);
+}
+
 TEST(RosBridgeMeshing, BadCloudsComeBackAsErrorsNotCrashes) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const pcl::PCLPointCloud2 all_nan =
