@@ -28,6 +28,31 @@ PACKAGES=(
   libglx-mesa0
   libpng-dev
 )
+# ROS 1 as Debian ships it (cmake/pcl_ms_ros.cmake): the nodelet and node,
+# pcd_to_pointcloud for the demo, rostest for the ROS tests, RViz. Without
+# them the library still builds and the rostests are reported as skipped;
+# PCL_MS_INSTALL_ROS=0 leaves them out.
+ROS_PACKAGES=(
+  ros-core-dev
+  libnodeletlib-dev
+  libnodeletlib-tools
+  libnodelet-dev
+  libpcl-ros-dev
+  pcl-ros-tools
+  libpcl-conversions-dev
+  libpcl-msgs-dev
+  libvisualization-msgs-dev
+  python3-rostest
+  python3-rospy
+  python3-sensor-msgs
+  python3-pcl-msgs
+  python3-visualization-msgs
+  python3-rosgraph-msgs
+  rviz
+)
+if [[ "${PCL_MS_INSTALL_ROS:-1}" != "0" ]]; then
+  PACKAGES+=("${ROS_PACKAGES[@]}")
+fi
 
 missing=()
 for package in "${PACKAGES[@]}"; do
