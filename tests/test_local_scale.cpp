@@ -202,6 +202,32 @@ TEST(Viewpoint, PclClassTakesTheSensorOriginUnlessToldNotTo) {
   EXPECT_EQ(trianglesOf(), without);
 }
 
+TEST(Viewpoint, KinectFrameFromPclIsOrientedTowardsTheCamera) {
+  // PCL's organized 640 x 480 test frame (NaN where there is no depth): with
+  // one global length it had 7 non-orientable pieces and 406 boundary loops.
+  pcl::PCLPointCloud2 blob;
+  std::string error;
+  ASSERT_TRUE(pcl_ms::loadPointCloud(pcl_ms_test::dataPath("table_scene_mug_stereo_textured.pcd"),
+                                     blob, error))
+      << error;
+  auto frame = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  pcl::fromPCLPointCloud2(blob, *frame);
+  ASSERT_TRUE(frame->isOrganized());
+  pcl::MedialScaffoldReconstruction<pcl::PointXYZ> reconstruction;
+  reconstruction.setInputCloud(frame);
+  pcl::PolygonMesh mesh;
+  reconstruction.reconstruct(mesh);
+  ASSERT_EQ(reconstruction.getErrorMessage(), "");
+  const pcl_ms::Result &result = reconstruction.getResult();
+  const std::vector<Eigen::Vector3d> points = positions(*frame);
+  const MeshTopologyReport topology = pcl_ms::analyzeMesh(points, result.triangles);
+  expectCleanManifold(topology);
+  EXPECT_EQ(result.numberOfNonOrientableComponents(), 0u);
+  EXPECT_EQ(topology.inconsistently_oriented_edges, 0u);
+  EXPECT_LE(topology.boundary_loops, 203u); // at most half of 406
+  EXPECT_GE(facingShare(points, result.triangles, Eigen::Vector3d::Zero()), 0.95);
+}
+
 TEST(Viewpoint, ClosedSurfacesStayOutward) {
   // A viewpoint inside the sphere must not turn it inside out.
   const auto sphere = pcl_ms_tools::sphereWithDensityGradient();
