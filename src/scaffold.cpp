@@ -188,6 +188,7 @@ public:
     // The tetrahedra are no longer needed: free them before the edge graph.
     cells_.clear();
     cells_.shrink_to_fit();
+    chunk_gabriel_ = {};
     delaunay.clear();
     if (options_.fixed_triangles)
       addFixedTriangles(*options_.fixed_triangles);
@@ -265,21 +266,28 @@ private:
       float circumradius;
     };
     std::vector<std::vector<GabrielTriangle>> chunk_triangles(chunkCount(cells_.size()));
+    chunk_gabriel_.assign(chunkCount(cells_.size()), {});
     forEachChunk(cells_.size(), options_.num_threads,
                  [&](std::size_t chunk, std::size_t begin, std::size_t end) {
                    auto &gabriel = chunk_triangles[chunk];
+                   std::vector<bool> &flags = chunk_gabriel_[chunk];
                    for (std::size_t index = begin; index < end; ++index)
                      forEachOwnedFacet(
                          delaunay, cells_[index],
                          [&](CellHandle cell, int i, const auto &vertices) {
                            const KernelPoint &a = vertices[0]->point(), &b = vertices[1]->point(),
                                              &c = vertices[2]->point();
-                           if (CGAL::collinear(a, b, c))
+                           if (CGAL::collinear(a, b, c)) {
+                             flags.push_back(false);
                              return;
+                           }
                            const Eigen::Vector3d p = toEigen(a), q = toEigen(b), r = toEigen(c);
                            const Circle circle = circumcircle(p, q, r);
-                           if (!scaffold_.planar && !isGabriel(delaunay, cell, i, vertices, circle,
-                                                               triangleShape(p, q, r).compactness))
+                           const bool is_gabriel =
+                               scaffold_.planar || isGabriel(delaunay, cell, i, vertices, circle,
+                                                             triangleShape(p, q, r).compactness);
+                           flags.push_back(is_gabriel);
+                           if (!is_gabriel)
                              return;
                            gabriel.push_back(
                                {{vertices[0]->info(), vertices[1]->info(), vertices[2]->info()},
@@ -319,24 +327,23 @@ private:
                             corners_at[2 * std::size_t{slot} + 1]);
     };
     // Step 1. 0 marks a point on no Gabriel triangle (rare: each of its
-    // triangles has a neighbour inside its diametral sphere). Ties in size
-    // are broken by angle, so the result does not depend on the order.
+    // triangles has a neighbour inside its diametral sphere). Angles are
+    // computed smallest triangle first, only until the quarter turn is
+    // covered; the value reached does not depend on the order of equal radii.
     std::vector<float> own(n, 0.0f);
     forEachChunk(n, options_.num_threads, [&](std::size_t, std::size_t begin, std::size_t end) {
-      std::vector<std::pair<float, float>> by_size; // (circumradius, angle at the point)
+      std::vector<std::pair<float, std::uint32_t>> by_size; // (circumradius, slot)
       for (std::size_t v = begin; v < end; ++v) {
         by_size.clear();
-        for (std::uint32_t slot = offsets[v]; slot < offsets[v + 1]; ++slot) {
-          const auto [b, c] = cornersOf(slot);
-          const Eigen::Vector3d to_b = points_[b] - points_[v], to_c = points_[c] - points_[v];
-          by_size.emplace_back(radii_at[slot], static_cast<float>(std::atan2(
-                                                   to_b.cross(to_c).norm(), to_b.dot(to_c))));
-        }
+        for (std::uint32_t slot = offsets[v]; slot < offsets[v + 1]; ++slot)
+          by_size.emplace_back(radii_at[slot], slot);
         std::sort(by_size.begin(), by_size.end());
         double covered = 0;
-        for (const auto &[radius, angle] : by_size) {
+        for (const auto &[radius, slot] : by_size) {
           own[v] = radius;
-          covered += angle;
+          const auto [b, c] = cornersOf(slot);
+          const Eigen::Vector3d to_b = points_[b] - points_[v], to_c = points_[c] - points_[v];
+          covered += std::atan2(to_b.cross(to_c).norm(), to_b.dot(to_c));
           if (covered >= scale_turn_fraction * 2 * M_PI)
             break;
         }
@@ -427,10 +434,13 @@ private:
         cells_.size(), options_.num_threads,
         [&](std::size_t chunk, std::size_t begin, std::size_t end) {
           ChunkCandidates &out = chunks[chunk];
+          // The facets come in the order measureLocalScales saw them in.
+          std::vector<bool>::const_iterator gabriel_flag = chunk_gabriel_[chunk].begin();
           for (std::size_t index = begin; index < end; ++index)
             forEachOwnedFacet(
                 delaunay, cells_[index],
                 [&](CellHandle cell, int i, const std::array<VertexHandle, 3> &handles) {
+                  const bool gabriel = *gabriel_flag++;
                   Candidate candidate;
                   for (int k = 0; k < 3; ++k)
                     candidate.vertices[k] = handles[k]->info();
@@ -461,7 +471,7 @@ private:
                     // Both Voronoi pieces are infinite in a plane: rank by shape and size.
                     candidate.type = CandidateType::acute;
                     shock_length = local_scale;
-                  } else if (isGabriel(delaunay, cell, i, handles, circle, shape.compactness)) {
+                  } else if (gabriel) {
                     const bool acute = CGAL::angle(handles[2]->point(), handles[0]->point(),
                                                    handles[1]->point()) == CGAL::ACUTE &&
                                        CGAL::angle(handles[0]->point(), handles[1]->point(),
@@ -636,6 +646,9 @@ private:
   const ScaffoldOptions &options_;
   MedialScaffold scaffold_;
   std::vector<CellHandle> cells_;
+  /// Per chunk of cells, whether each facet visited is a Gabriel triangle
+  /// (measured once for the local scales, read again for the candidates).
+  std::vector<std::vector<bool>> chunk_gabriel_;
 };
 
 } // namespace
