@@ -119,5 +119,11 @@ else
   echo "warning: no side_by_side.png for the bunny; README written without the picture" >&2
   picture=
 fi
+# The Kinect frame's picture, linked from the README's viewpoint section.
+if [[ -f $work/mug/side_by_side.png ]]; then
+  cp "$work/mug/side_by_side.png" docs/kinect_mug_side_by_side.png
+else
+  echo "warning: no side_by_side.png for the Kinect frame" >&2
+fi
 python3 "$helper" table "$work" README.md $picture
 echo "README.md table rewritten in $((SECONDS - start)) s; outputs in $work"
