@@ -46,6 +46,7 @@ struct Options {
   int threads = 1;
   unsigned int bucket_points = 0; // 0: automatic
   int grid = 0;
+  double time_limit = 0; // seconds, 0: none
   bool quiet = false;
   bool help = false;
 };
@@ -75,6 +76,8 @@ void printHelp(const char *program) {
   print_value("%zu", pcl_ms::automatic_bucketing_threshold);
   print_info(" points (default 0)\n");
   print_info("  -grid N         cut the bounding box into N x N x N buckets instead\n");
+  print_info("  -time_limit S   give up after S seconds with an error and no output file,\n"
+             "                  0 = no limit (default 0)\n");
   print_info("  -q              quiet: print nothing but errors\n");
   print_info("  -h              this help\n\n");
   print_info("Exit status: 0 success, 1 bad arguments, 2 file error, 3 reconstruction failed.\n");
@@ -83,8 +86,8 @@ void printHelp(const char *program) {
 /// Collects the two file names and checks every option and its value.
 /// Numbers are read with PCL's parser, which rejects trailing garbage.
 bool parseArguments(int argc, char **argv, Options &options, std::string &error) {
-  const std::vector<std::string> value_options = {"-rho", "-fill_holes", "-threads",
-                                                  "-bucket_points", "-grid"};
+  const std::vector<std::string> value_options = {"-rho",           "-fill_holes", "-threads",
+                                                  "-bucket_points", "-grid",       "-time_limit"};
   std::vector<std::string> positional;
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
@@ -131,6 +134,9 @@ bool parseArguments(int argc, char **argv, Options &options, std::string &error)
   if (pcl::console::find_argument(argc, argv, "-grid") >= 0 &&
       pcl::console::parse_argument(argc, argv, "-grid", options.grid) < 0)
     return badValue("-grid");
+  if (pcl::console::find_argument(argc, argv, "-time_limit") >= 0 &&
+      pcl::console::parse_argument(argc, argv, "-time_limit", options.time_limit) < 0)
+    return badValue("-time_limit");
 
   if (positional.size() != 2) {
     error = "expected input and output file names, got " + std::to_string(positional.size()) +
@@ -218,6 +224,7 @@ void printReport(const pcl_ms::Result &result, double load_ms, double save_ms) {
   printRow("input points", "%10.0f", static_cast<double>(result.input_points));
   printRow("invalid points skipped", "%10.0f", static_cast<double>(result.invalid_points));
   printRow("duplicates merged", "%10.0f", static_cast<double>(result.duplicate_points));
+  printRow("far points left out", "%10.0f", static_cast<double>(result.far_points));
   printRow("triangles", "%10.0f", static_cast<double>(result.triangles.size()));
   printRow("boundary loops", "%10.0f", static_cast<double>(result.boundary_loops.size()));
   print_info("  %-22s", "components");
@@ -287,6 +294,7 @@ int run(int argc, char **argv) {
   parameters.num_threads = options.threads;
   parameters.bucket_points = options.bucket_points;
   parameters.grid_buckets = options.grid;
+  parameters.time_limit_seconds = options.time_limit;
   if (const std::string reason = parameters.validate(); !reason.empty())
     return fail(kBadArguments, reason);
 

@@ -297,8 +297,9 @@ private:
 class BucketedMesher {
 public:
   BucketedMesher(const std::vector<Eigen::Vector3d> &points,
-                 const std::vector<Eigen::Vector3f> *normals, const Parameters &parameters)
-      : points_(points), normals_(normals), parameters_(parameters),
+                 const std::vector<Eigen::Vector3f> *normals, const Parameters &parameters,
+                 const Deadline *deadline)
+      : points_(points), normals_(normals), parameters_(parameters), deadline_(deadline),
         tree_(points,
               parameters.bucket_points > 0 ? parameters.bucket_points : default_bucket_points,
               parameters.grid_buckets) {}
@@ -423,7 +424,7 @@ private:
     task.core.resize(members.size());
     for (std::size_t i = 0; i < members.size(); ++i)
       task.core[i] = tree_.leafOf(members[i]) == leaf_id;
-    outcome = meshBucket(task, parameters_);
+    outcome = meshBucket(task, parameters_, deadline_);
     leaf.triangles = toGlobal(outcome.triangles, members);
     markMayPinch(outcome.cut_vertices, members);
     return members.size() - leaf.points.size();
@@ -490,7 +491,7 @@ private:
       for (const Triangle &triangle : fixed)
         task.fixed_triangles.push_back(
             {localIndex(triangle[0]), localIndex(triangle[1]), localIndex(triangle[2])});
-      outcome = meshBucket(task, parameters_);
+      outcome = meshBucket(task, parameters_, deadline_);
       added = toGlobal(outcome.triangles, members);
       markMayPinch(outcome.cut_vertices, members);
       for (std::size_t i = 0; i < members.size(); ++i)
@@ -529,6 +530,7 @@ private:
   const std::vector<Eigen::Vector3d> &points_;
   const std::vector<Eigen::Vector3f> *normals_;
   const Parameters &parameters_;
+  const Deadline *deadline_;
   BucketTree tree_;
   double margin_ = 0;
   BucketedSurface surface_;
@@ -537,7 +539,8 @@ private:
 
 } // namespace
 
-BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters) {
+BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters,
+                         const Deadline *deadline) {
   BucketOutcome outcome;
   if (task.points.size() < 3) {
     outcome.error = "fewer than 3 points";
@@ -553,13 +556,17 @@ BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters) {
     options.d_med = task.d_med;
     options.fixed_triangles = task.fixed_triangles.empty() ? nullptr : &task.fixed_triangles;
     options.frozen_vertices = task.frozen.empty() ? nullptr : &task.frozen;
+    if (deadline)
+      deadline->check("the buckets");
     MedialScaffold scaffold = buildMedialScaffold(task.points, options);
+    if (deadline)
+      deadline->check("the buckets");
     outcome.d_med = scaffold.d_med;
     outcome.delaunay_seconds = scaffold.delaunay_seconds;
     outcome.scaffold_seconds = secondsSince(start) - scaffold.delaunay_seconds;
 
     const Clock::time_point greedy_start = Clock::now();
-    GreedyMesher mesher(scaffold, task.points, parameters);
+    GreedyMesher mesher(scaffold, task.points, parameters, deadline);
     mesher.run();
     for (const Triangle &triangle : mesher.triangles(false)) {
       if (task.core[triangle[0]] && task.core[triangle[1]] && task.core[triangle[2]]) {
@@ -575,6 +582,8 @@ BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters) {
         std::unique(outcome.cut_vertices.begin(), outcome.cut_vertices.end()),
         outcome.cut_vertices.end());
     outcome.greedy_seconds = secondsSince(greedy_start);
+  } catch (const TimeLimitExceeded &) {
+    throw; // the whole run stops, not just this unit
   } catch (const ReconstructionError &error) {
     outcome.error = error.what();
     outcome.triangles.clear();
@@ -592,8 +601,8 @@ bool usesBuckets(std::size_t points, const Parameters &parameters) {
 
 BucketedSurface meshInBuckets(const std::vector<Eigen::Vector3d> &points,
                               const std::vector<Eigen::Vector3f> *normals,
-                              const Parameters &parameters) {
-  return BucketedMesher(points, normals, parameters).run();
+                              const Parameters &parameters, const Deadline *deadline) {
+  return BucketedMesher(points, normals, parameters, deadline).run();
 }
 
 } // namespace pcl_ms

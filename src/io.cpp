@@ -74,7 +74,8 @@ bool startsWith(std::string_view text, std::string_view prefix) {
 }
 
 /// Whole-token number parsing, locale independent; accepts a leading '+'.
-bool parseDouble(std::string_view token, double &value) {
+/// A float is rounded once from the text, as a writer's binary copy would be.
+template <typename Number> bool parseNumber(std::string_view token, Number &value) {
   if (!token.empty() && token.front() == '+')
     token.remove_prefix(1);
   if (token.empty())
@@ -84,14 +85,10 @@ bool parseDouble(std::string_view token, double &value) {
   return code == std::errc() && end == last;
 }
 
+bool parseDouble(std::string_view token, double &value) { return parseNumber(token, value); }
+
 template <typename Integer> bool parseInteger(std::string_view token, Integer &value) {
-  if (!token.empty() && token.front() == '+')
-    token.remove_prefix(1);
-  if (token.empty())
-    return false;
-  const char *last = token.data() + token.size();
-  const auto [end, code] = std::from_chars(token.data(), last, value);
-  return code == std::errc() && end == last;
+  return parseNumber(token, value);
 }
 
 /// Printable form of a header word for error messages (garbage stays short).
@@ -611,7 +608,17 @@ public:
       const std::size_t start = position_;
       while (position_ < body_.size() && !isBlank(body_[position_]))
         ++position_;
-      return parseDouble(body_.substr(start, position_ - start), value);
+      const std::string_view token = body_.substr(start, position_ - start);
+      // A float property holds what a binary file would: the text rounded
+      // once to float, so ASCII and binary copies match position for position.
+      if (type == PlyType::Float32) {
+        float single;
+        if (!parseNumber(token, single))
+          return false;
+        value = single;
+        return true;
+      }
+      return parseDouble(token, value);
     }
     const std::size_t size = plyTypeSize(type);
     if (position_ + size > body_.size())

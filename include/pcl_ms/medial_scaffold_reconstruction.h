@@ -107,6 +107,11 @@ public:
   void setGridBuckets(int n) { parameters_.grid_buckets = n; }
   int getGridBuckets() const { return parameters_.grid_buckets; }
 
+  /// Gives up after this many seconds: reconstruct() then yields no mesh and
+  /// getErrorMessage() says so. 0 (default) = no limit.
+  void setTimeLimit(double seconds) { parameters_.time_limit_seconds = seconds; }
+  double getTimeLimit() const { return parameters_.time_limit_seconds; }
+
   /** \brief Triangles (indices into the input cloud) that are part of the
    * surface from the start; the method completes the mesh around them
    * (default: none). They must be edge-manifold and use valid points. */
