@@ -27,6 +27,10 @@ PACKAGES=(
   libgl1-mesa-dri
   libglx-mesa0
   libpng-dev
+  # scripts/sanitizers.sh: clang 14 with its sanitizer runtimes and libFuzzer.
+  clang-14
+  libclang-rt-14-dev
+  libfuzzer-14-dev
 )
 
 missing=()

@@ -349,6 +349,7 @@ public:
       throw ReconstructionError("no bucket could be meshed: " + leaf_outcomes.front().error);
     std::nth_element(bucket_d_meds.begin(), bucket_d_meds.begin() + bucket_d_meds.size() / 2,
                      bucket_d_meds.end());
+    const double largest_d_med = *std::max_element(bucket_d_meds.begin(), bucket_d_meds.end());
     surface_.d_med = bucket_d_meds[bucket_d_meds.size() / 2];
     surface_.statistics.buckets_seconds = secondsSince(stage);
 
@@ -388,6 +389,15 @@ public:
       may_pinch[v] = may_pinch_[v] != 0;
     surface_.statistics.bow_tie_triangles_removed =
         splitBowTies(surface_.triangles, points_.size(), may_pinch);
+    // Each bucket kept candidates below rho times its own d_med, a few
+    // percent apart from bucket to bucket and from the whole cloud's. Where a
+    // bucket's threshold was the lower one, a small gap whose closing needs a
+    // side just above it stays open, where the one-piece mesh has triangles.
+    // Every bucket's threshold is the method's own: small loops are closed
+    // with sides up to the largest of them, so buckets add no boundary loop.
+    surface_.statistics.holes_filled =
+        fillHoles(surface_.triangles, points_, parameters_.fill_holes_max_edges,
+                  parameters_.rho * largest_d_med);
     surface_.statistics.seams_seconds = secondsSince(stage);
     return std::move(surface_);
   }

@@ -73,28 +73,25 @@ TEST_F(PlyPrecision, AsciiFloatPropertiesReadAsTheirBinaryCopy) {
   EXPECT_EQ(ascii_triangles, binary_triangles);
 }
 
-TEST_F(PlyPrecision, DoublePropertiesKeepTheirFullPrecision) {
-  writeFile(path("double.ply"), "ply\nformat ascii 1.0\nelement vertex 3\n"
-                                "property double x\nproperty double y\nproperty double z\n"
-                                "element face 1\nproperty list uchar int vertex_indices\n"
-                                "end_header\n0.1 0 0\n0 0.2 0\n0 0 0.3\n3 0 1 2\n");
+/// A three-vertex, one-face ASCII PLY whose coordinates have `type`.
+std::string asciiTriangle(const std::string &type, const std::string &vertex_lines) {
+  return "ply\nformat ascii 1.0\nelement vertex 3\nproperty " + type + " x\nproperty " + type +
+         " y\nproperty " + type + " z\nelement face 1\nproperty list uchar int vertex_indices\n" +
+         "end_header\n" + vertex_lines + "3 0 1 2\n";
+}
+
+TEST_F(PlyPrecision, DoublesKeepTheirPrecisionAndFloatsTheirRange) {
+  writeFile(path("double.ply"), asciiTriangle("double", "0.1 0 0\n0 0.2 0\n0 0 0.3\n"));
   std::vector<Eigen::Vector3d> vertices;
   std::vector<pcl_ms::Triangle> triangles;
   std::string error;
   ASSERT_TRUE(pcl_ms::loadMesh(path("double.ply"), vertices, triangles, error)) << error;
   EXPECT_EQ(vertices[0].x(), 0.1);
   EXPECT_EQ(vertices[2].z(), 0.3);
-}
 
-TEST_F(PlyPrecision, AFloatOutsideTheFloatRangeIsAnError) {
-  writeFile(path("overflow.ply"), "ply\nformat ascii 1.0\nelement vertex 3\n"
-                                  "property float x\nproperty float y\nproperty float z\n"
-                                  "element face 1\nproperty list uchar int vertex_indices\n"
-                                  "end_header\n1e39 0 0\n0 1 0\n0 0 1\n3 0 1 2\n");
-  std::vector<Eigen::Vector3d> vertices;
-  std::vector<pcl_ms::Triangle> triangles;
-  std::string error;
-  EXPECT_FALSE(pcl_ms::loadMesh(path("overflow.ply"), vertices, triangles, error));
+  writeFile(path("overflow.ply"), asciiTriangle("float", "1e39 0 0\n0 1 0\n0 0 1\n"));
+  EXPECT_FALSE(pcl_ms::loadMesh(path("overflow.ply"), vertices, triangles, error))
+      << "a float property cannot hold 1e39";
   EXPECT_NE(error.find("PLY"), std::string::npos) << error;
 }
 

@@ -91,6 +91,7 @@ struct BucketStatistics {
   std::size_t seam_triangles = 0;            // triangles the seams added
   std::size_t failed_units = 0;              // buckets or zones left empty (e.g. collinear points)
   std::size_t bow_tie_triangles_removed = 0; // smaller fans where seams met
+  std::size_t holes_filled = 0;              // small loops closed at the largest bucket's threshold
   double buckets_seconds = 0;                // wall clock
   double seams_seconds = 0;                  // wall clock
 };
