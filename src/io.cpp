@@ -507,6 +507,11 @@ bool parsePlyHeader(std::istream &in, PlyHeader &header, std::string &error) {
     const std::string_view key = words.front();
     if (key == "end_header") {
       break;
+    } else if (key == "obj_info" && !startsWith(line, "obj_info")) {
+      // PCL's reader asserts (and aborts) on an obj_info line that does not
+      // start with the keyword itself.
+      error = where + "obj_info must start the line";
+      return false;
     } else if (key == "comment" || key == "obj_info") {
       continue;
     } else if (key == "format") {
@@ -940,8 +945,16 @@ bool loadPlyMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices
             corners.clear();
           for (std::size_t i = 0; ok && i < length; ++i) {
             ok = reader.read(property.value_type, value);
-            if (keep)
-              corners.push_back(static_cast<std::int64_t>(value));
+            if (!ok || !keep)
+              continue;
+            // -1 separates triangle strips; anything else must be an index.
+            if (!(value >= -1 && value <= std::numeric_limits<VertexIndex>::max()) ||
+                value != std::floor(value)) {
+              error = "corrupt PLY file: vertex index " + std::to_string(value) + " in element '" +
+                      element.name + "' record " + std::to_string(r);
+              return false;
+            }
+            corners.push_back(static_cast<std::int64_t>(value));
           }
         } else if (ok && is_vertex) {
           if (static_cast<int>(p) == x)
