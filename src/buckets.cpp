@@ -395,9 +395,11 @@ public:
     // side just above it stays open, where the one-piece mesh has triangles.
     // Every bucket's threshold is the method's own: small loops are closed
     // with sides up to the largest of them, so buckets add no boundary loop.
-    surface_.statistics.holes_filled =
-        fillHoles(surface_.triangles, points_, parameters_.fill_holes_max_edges,
-                  parameters_.rho * largest_d_med);
+    arena.execute([&] { // its parallel loops use the threads the user allowed
+      surface_.statistics.holes_filled =
+          fillHoles(surface_.triangles, points_, parameters_.fill_holes_max_edges,
+                    parameters_.rho * largest_d_med);
+    });
     surface_.statistics.seams_seconds = secondsSince(stage);
     return std::move(surface_);
   }

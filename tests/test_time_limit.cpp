@@ -48,7 +48,8 @@ TEST(TimeLimit, TheGreedyPassesAreStoppedFromInside) {
   pcl_ms::ScaffoldOptions options;
   pcl_ms::MedialScaffold scaffold = pcl_ms::buildMedialScaffold(points, options);
   const pcl_ms::Deadline expired(1e-9);
-  pcl_ms::GreedyMesher mesher(scaffold, points, pcl_ms::Parameters(), &expired);
+  const pcl_ms::Parameters parameters; // outlives the mesher, which keeps a reference
+  pcl_ms::GreedyMesher mesher(scaffold, points, parameters, &expired);
   EXPECT_THROW(mesher.run(), pcl_ms::TimeLimitExceeded);
 }
 
