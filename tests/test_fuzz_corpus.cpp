@@ -64,22 +64,25 @@ TEST_F(FuzzCorpusReaders, EveryReaderLoadsOrRejectsEveryInput) {
         std::vector<Eigen::Vector3d> vertices;
         std::vector<pcl_ms::Triangle> triangles;
         loaded = pcl_ms::loadMesh(copy, vertices, triangles, error);
-        if (loaded)
+        if (loaded) {
           for (const pcl_ms::Triangle &triangle : triangles)
             for (pcl_ms::VertexIndex v : triangle)
               ASSERT_LT(v, vertices.size());
+        }
       } else {
         pcl::PCLPointCloud2 cloud;
         loaded = pcl_ms::loadPointCloud(copy, cloud, error);
-        if (loaded)
+        if (loaded) {
           EXPECT_EQ(cloud.data.size(), std::size_t{cloud.row_step} * cloud.height);
+        }
       }
       // Seeds are valid files; findings (named finding_*) are whatever the
       // fuzzer made of them: those must be rejected with a reason or loaded.
-      if (file.filename().string().rfind("finding_", 0) != 0)
+      if (file.filename().string().rfind("finding_", 0) != 0) {
         EXPECT_TRUE(loaded) << error;
-      else if (!loaded)
+      } else if (!loaded) {
         EXPECT_FALSE(error.empty());
+      }
     }
   }
 }
