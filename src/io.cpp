@@ -290,6 +290,11 @@ bool checkPcdHeader(const std::string &path, std::uintmax_t file_size, std::stri
       return false;
     }
     const std::string_view text = trim(line);
+    if (text.empty() && !line.empty()) {
+      // PCL's reader skips empty lines but crashes after one of blanks only.
+      error = "PCD header line " + std::to_string(line_number) + " holds only blanks";
+      return false;
+    }
     if (text.empty() || text.front() == '#')
       continue;
     const std::vector<std::string_view> words = splitWords(text);
