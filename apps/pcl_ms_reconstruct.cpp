@@ -48,6 +48,7 @@ struct Options {
   int grid = 0;
   std::vector<double> viewpoint; // empty, or x, y, z
   bool no_viewpoint = false;
+  double time_limit = 0; // seconds, 0: none
   bool quiet = false;
   bool help = false;
 };
@@ -82,6 +83,8 @@ void printHelp(const char *program) {
              "                  VIEWPOINT) of an organized cloud, i.e. a depth frame, or a\n"
              "                  non-zero one; none for other clouds)\n");
   print_info("  -no_viewpoint   no viewpoint, even for an organized cloud\n");
+  print_info("  -time_limit S   give up after S seconds with an error and no output file,\n"
+             "                  0 = no limit (default 0)\n");
   print_info("  -q              quiet: print nothing but errors\n");
   print_info("  -h              this help\n\n");
   print_info("Exit status: 0 success, 1 bad arguments, 2 file error, 3 reconstruction failed.\n");
@@ -91,7 +94,8 @@ void printHelp(const char *program) {
 /// Numbers are read with PCL's parser, which rejects trailing garbage.
 bool parseArguments(int argc, char **argv, Options &options, std::string &error) {
   const std::vector<std::string> value_options = {"-rho",           "-fill_holes", "-threads",
-                                                  "-bucket_points", "-grid",       "-viewpoint"};
+                                                  "-bucket_points", "-grid",       "-viewpoint",
+                                                  "-time_limit"};
   std::vector<std::string> positional;
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
@@ -147,6 +151,9 @@ bool parseArguments(int argc, char **argv, Options &options, std::string &error)
       return false;
     }
   }
+  if (pcl::console::find_argument(argc, argv, "-time_limit") >= 0 &&
+      pcl::console::parse_argument(argc, argv, "-time_limit", options.time_limit) < 0)
+    return badValue("-time_limit");
 
   if (positional.size() != 2) {
     error = "expected input and output file names, got " + std::to_string(positional.size()) +
@@ -237,6 +244,7 @@ void printReport(const pcl_ms::Result &result, double load_ms, double save_ms) {
   printRow("input points", "%10.0f", static_cast<double>(result.input_points));
   printRow("invalid points skipped", "%10.0f", static_cast<double>(result.invalid_points));
   printRow("duplicates merged", "%10.0f", static_cast<double>(result.duplicate_points));
+  printRow("far points left out", "%10.0f", static_cast<double>(result.far_points));
   printRow("triangles", "%10.0f", static_cast<double>(result.triangles.size()));
   printRow("boundary loops", "%10.0f", static_cast<double>(result.boundary_loops.size()));
   print_info("  %-22s", "components");
@@ -308,6 +316,7 @@ int run(int argc, char **argv) {
   parameters.grid_buckets = options.grid;
   if (!options.viewpoint.empty())
     parameters.viewpoint = {{options.viewpoint[0], options.viewpoint[1], options.viewpoint[2]}};
+  parameters.time_limit_seconds = options.time_limit;
   if (const std::string reason = parameters.validate(); !reason.empty())
     return fail(kBadArguments, reason);
 

@@ -27,6 +27,10 @@ PACKAGES=(
   libgl1-mesa-dri
   libglx-mesa0
   libpng-dev
+  # scripts/sanitizers.sh: clang 14 with its sanitizer runtimes and libFuzzer.
+  clang-14
+  libclang-rt-14-dev
+  libfuzzer-14-dev
 )
 # ROS 1 as Debian ships it (cmake/pcl_ms_ros.cmake): the nodelet and node,
 # pcd_to_pointcloud for the demo, rostest for the ROS tests, RViz. Without

@@ -251,15 +251,16 @@ private:
   int grid_ = 0;
 };
 
-/// Median nearest-neighbour distance from a few points of each bucket to
-/// the other points of that bucket (a bucket is big enough for this).
-double medianSpacing(const std::vector<Eigen::Vector3d> &points, BucketTree &tree) {
-  std::vector<double> distances;
+/// For each bucket, the median nearest-neighbour distance from a few of its
+/// points to the others (a bucket is big enough for this); 0 for a bucket
+/// of fewer than 2 points. Buckets differ: a cloud's density varies.
+std::vector<double> bucketSpacings(const std::vector<Eigen::Vector3d> &points, BucketTree &tree) {
+  std::vector<double> spacings;
   for (int leaf : tree.leaves()) {
     const std::vector<VertexIndex> &members = tree.nodes()[leaf].points;
-    if (members.size() < 2)
-      continue;
-    const std::size_t samples = std::min(spacing_samples_per_bucket, members.size());
+    std::vector<double> distances;
+    const std::size_t samples =
+        members.size() < 2 ? 0 : std::min(spacing_samples_per_bucket, members.size());
     for (std::size_t s = 0; s < samples; ++s) {
       const VertexIndex query = members[s * members.size() / samples];
       double nearest = std::numeric_limits<double>::infinity();
@@ -268,11 +269,14 @@ double medianSpacing(const std::vector<Eigen::Vector3d> &points, BucketTree &tre
           nearest = std::min(nearest, (points[other] - points[query]).squaredNorm());
       distances.push_back(std::sqrt(nearest));
     }
+    if (distances.empty()) {
+      spacings.push_back(0);
+      continue;
+    }
+    std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+    spacings.push_back(distances[distances.size() / 2]);
   }
-  if (distances.empty())
-    return 0;
-  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
-  return distances[distances.size() / 2];
+  return spacings;
 }
 
 /// Calls progress one at a time from whichever thread finished a unit.
@@ -297,8 +301,9 @@ private:
 class BucketedMesher {
 public:
   BucketedMesher(const std::vector<Eigen::Vector3d> &points,
-                 const std::vector<Eigen::Vector3f> *normals, const Parameters &parameters)
-      : points_(points), normals_(normals), parameters_(parameters),
+                 const std::vector<Eigen::Vector3f> *normals, const Parameters &parameters,
+                 const Deadline *deadline)
+      : points_(points), normals_(normals), parameters_(parameters), deadline_(deadline),
         tree_(points,
               parameters.bucket_points > 0 ? parameters.bucket_points : default_bucket_points,
               parameters.grid_buckets) {}
@@ -317,9 +322,14 @@ public:
     surface_.statistics.buckets = leaves.size();
     surface_.statistics.seam_zones = inner.size();
 
-    const double spacing = medianSpacing(points_, tree_);
-    const double estimated_d_med = d_med_per_spacing * spacing;
-    margin_ = (parameters_.rho + margin_context_in_d_med) * estimated_d_med;
+    // Each bucket's margin follows its own spacing: a triangle is up to rho
+    // local scales long, and a sparse bucket's scale is larger.
+    const std::vector<double> spacings = bucketSpacings(points_, tree_);
+    const double largest_spacing = *std::max_element(spacings.begin(), spacings.end());
+    leaf_margin_.resize(spacings.size());
+    for (std::size_t leaf = 0; leaf < spacings.size(); ++leaf)
+      leaf_margin_[leaf] = (parameters_.rho + margin_context_in_d_med) * d_med_per_spacing *
+                           (spacings[leaf] > 0 ? spacings[leaf] : largest_spacing);
 
     tbb::task_arena arena = detail::threadArena(parameters_.num_threads);
     Clock::time_point stage = Clock::now();
@@ -423,12 +433,13 @@ private:
   /// Returns how many margin points it meshed.
   std::size_t meshLeaf(Node &leaf, BucketOutcome &outcome) {
     const std::uint32_t leaf_id = leaf.first_leaf;
-    const std::vector<VertexIndex> members = tree_.gather(leaf.region.expanded(margin_));
+    const std::vector<VertexIndex> members =
+        tree_.gather(leaf.region.expanded(leaf_margin_[leaf_id]));
     BucketTask task = makeTask(members);
     task.core.resize(members.size());
     for (std::size_t i = 0; i < members.size(); ++i)
       task.core[i] = tree_.leafOf(members[i]) == leaf_id;
-    outcome = meshBucket(task, parameters_);
+    outcome = meshBucket(task, parameters_, deadline_);
     leaf.triangles = toGlobal(outcome.triangles, members);
     markMayPinch(outcome.cut_vertices, members);
     // Each point's scale is the one its own bucket measured, where its
@@ -445,25 +456,23 @@ private:
   /// of the plane (core), and points of other subtrees within the margin
   /// around the node's region. A triangle across the plane is shorter than
   /// rho times the largest local scale near it, so that is the zone's half
-  /// width (at most the margin, beyond which buckets had no context).
+  /// width; a sparse part's can exceed the buckets' margin.
   /// Triangles of the subtree that touch the core are fixed; their corners
   /// outside the zone are frozen. Returns the number of core points.
   std::size_t stitch(Node &node, BucketOutcome &outcome) {
+    // The widest margin of the subtree's buckets.
+    const double margin = *std::max_element(leaf_margin_.begin() + node.first_leaf,
+                                            leaf_margin_.begin() + node.end_leaf);
     auto slabOf = [&](double half_width) {
-      Box slab = node.region.expanded(margin_);
+      Box slab = node.region.expanded(std::max(margin, half_width));
       slab.low[node.axis] = std::max(slab.low[node.axis], node.split - half_width);
       slab.high[node.axis] = std::min(slab.high[node.axis], node.split + half_width);
       return slab;
     };
-    std::vector<VertexIndex> zone = tree_.gather(slabOf(margin_));
     float largest_scale = 0;
-    for (VertexIndex v : zone)
+    for (VertexIndex v : tree_.gather(slabOf(margin)))
       largest_scale = std::max(largest_scale, surface_.local_scale[v]);
-    const double half_width = std::min(margin_, parameters_.rho * largest_scale);
-    const Box slab = slabOf(half_width);
-    zone.erase(std::remove_if(zone.begin(), zone.end(),
-                              [&](VertexIndex v) { return !slab.contains(points_[v]); }),
-               zone.end());
+    const std::vector<VertexIndex> zone = tree_.gather(slabOf(parameters_.rho * largest_scale));
     // Every triangle of the subtree is tested: a lookup table, not a search.
     std::vector<bool> in_zone(points_.size(), false);
     for (VertexIndex v : zone)
@@ -517,7 +526,7 @@ private:
       for (const Triangle &triangle : fixed)
         task.fixed_triangles.push_back(
             {localIndex(triangle[0]), localIndex(triangle[1]), localIndex(triangle[2])});
-      outcome = meshBucket(task, parameters_);
+      outcome = meshBucket(task, parameters_, deadline_);
       added = toGlobal(outcome.triangles, members);
       markMayPinch(outcome.cut_vertices, members);
       for (std::size_t i = 0; i < members.size(); ++i)
@@ -556,15 +565,17 @@ private:
   const std::vector<Eigen::Vector3d> &points_;
   const std::vector<Eigen::Vector3f> *normals_;
   const Parameters &parameters_;
+  const Deadline *deadline_;
   BucketTree tree_;
-  double margin_ = 0;
+  std::vector<double> leaf_margin_; // by leaf number
   BucketedSurface surface_;
   std::vector<std::uint8_t> may_pinch_ = std::vector<std::uint8_t>(points_.size(), 0);
 };
 
 } // namespace
 
-BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters) {
+BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters,
+                         const Deadline *deadline) {
   BucketOutcome outcome;
   if (task.points.size() < 3) {
     outcome.error = "fewer than 3 points";
@@ -581,14 +592,18 @@ BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters) {
     options.local_scale = task.local_scale.empty() ? nullptr : &task.local_scale;
     options.fixed_triangles = task.fixed_triangles.empty() ? nullptr : &task.fixed_triangles;
     options.frozen_vertices = task.frozen.empty() ? nullptr : &task.frozen;
+    if (deadline)
+      deadline->check("the buckets");
     MedialScaffold scaffold = buildMedialScaffold(task.points, options);
+    if (deadline)
+      deadline->check("the buckets");
     outcome.d_med = scaffold.d_med;
     outcome.local_scale = scaffold.local_scale;
     outcome.delaunay_seconds = scaffold.delaunay_seconds;
     outcome.scaffold_seconds = secondsSince(start) - scaffold.delaunay_seconds;
 
     const Clock::time_point greedy_start = Clock::now();
-    GreedyMesher mesher(scaffold, task.points, parameters);
+    GreedyMesher mesher(scaffold, task.points, parameters, deadline);
     mesher.run();
     for (const Triangle &triangle : mesher.triangles(false)) {
       if (task.core[triangle[0]] && task.core[triangle[1]] && task.core[triangle[2]]) {
@@ -604,6 +619,8 @@ BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters) {
         std::unique(outcome.cut_vertices.begin(), outcome.cut_vertices.end()),
         outcome.cut_vertices.end());
     outcome.greedy_seconds = secondsSince(greedy_start);
+  } catch (const TimeLimitExceeded &) {
+    throw; // the whole run stops, not just this unit
   } catch (const ReconstructionError &error) {
     outcome.error = error.what();
     outcome.triangles.clear();
@@ -622,8 +639,8 @@ bool usesBuckets(std::size_t points, const Parameters &parameters) {
 
 BucketedSurface meshInBuckets(const std::vector<Eigen::Vector3d> &points,
                               const std::vector<Eigen::Vector3f> *normals,
-                              const Parameters &parameters) {
-  return BucketedMesher(points, normals, parameters).run();
+                              const Parameters &parameters, const Deadline *deadline) {
+  return BucketedMesher(points, normals, parameters, deadline).run();
 }
 
 } // namespace pcl_ms

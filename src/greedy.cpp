@@ -99,11 +99,12 @@ constexpr double smooth_bending_angle = 0.35;
 class GreedyMesher::Impl {
 public:
   Impl(MedialScaffold &scaffold, const std::vector<Eigen::Vector3d> &points,
-       const Parameters &parameters, GreedyStatistics &statistics)
+       const Parameters &parameters, const Deadline *deadline, GreedyStatistics &statistics)
       : scaffold_(scaffold), candidates_(scaffold.candidates), points_(points),
-        parameters_(parameters), statistics_(statistics), mesh_(scaffold, points.size()),
-        states_(candidates_.size()), is_fixed_(candidates_.size(), false),
-        multi_fan_vertex_(points.size(), false), may_have_several_fans_(points.size(), false) {
+        parameters_(parameters), deadline_(deadline), statistics_(statistics),
+        mesh_(scaffold, points.size()), states_(candidates_.size()),
+        is_fixed_(candidates_.size(), false), multi_fan_vertex_(points.size(), false),
+        may_have_several_fans_(points.size(), false) {
     for (CandidateIndex t : scaffold.fixed)
       is_fixed_[t] = true;
     delay_multiplier_.resize(2 * static_cast<std::size_t>(parameters.max_delays) + 1);
@@ -364,6 +365,8 @@ private:
       queue.pop();
       if (!isCurrent(entry, queue_state))
         continue;
+      if (deadline_)
+        deadline_->checkEvery(deadline_counter_, "the greedy passes");
       const CandidateIndex t = entry.candidate();
       --queued_[queueNumber(queue_state)];
       states_[t].state = State::idle;
@@ -748,6 +751,8 @@ private:
       const VertexIndex v = pending.back();
       pending.pop_back();
       is_pending[v] = false;
+      if (deadline_)
+        deadline_->checkEvery(deadline_counter_, "the manifold sweep");
       if (mesh_.isSingleFan(v))
         continue;
       const auto fans = mesh_.fansAround(v);
@@ -797,6 +802,7 @@ private:
   std::vector<Candidate> &candidates_;
   const std::vector<Eigen::Vector3d> &points_;
   const Parameters &parameters_;
+  const Deadline *deadline_; // null: no time limit
   GreedyStatistics &statistics_;
   MeshTopology mesh_;
 
@@ -824,11 +830,12 @@ private:
   CandidateQueue queues_[2];       // Q1, Q2
   std::size_t queued_[2] = {0, 0}; // candidates whose state is that queue
   bool queue2_built_ = false;
+  std::uint32_t deadline_counter_ = 0;
 };
 
 GreedyMesher::GreedyMesher(MedialScaffold &scaffold, const std::vector<Eigen::Vector3d> &points,
-                           const Parameters &parameters)
-    : impl_(std::make_unique<Impl>(scaffold, points, parameters, statistics_)) {}
+                           const Parameters &parameters, const Deadline *deadline)
+    : impl_(std::make_unique<Impl>(scaffold, points, parameters, deadline, statistics_)) {}
 
 GreedyMesher::~GreedyMesher() = default;
 

@@ -74,7 +74,8 @@ bool startsWith(std::string_view text, std::string_view prefix) {
 }
 
 /// Whole-token number parsing, locale independent; accepts a leading '+'.
-bool parseDouble(std::string_view token, double &value) {
+/// A float is rounded once from the text, as a writer's binary copy would be.
+template <typename Number> bool parseNumber(std::string_view token, Number &value) {
   if (!token.empty() && token.front() == '+')
     token.remove_prefix(1);
   if (token.empty())
@@ -84,14 +85,10 @@ bool parseDouble(std::string_view token, double &value) {
   return code == std::errc() && end == last;
 }
 
+bool parseDouble(std::string_view token, double &value) { return parseNumber(token, value); }
+
 template <typename Integer> bool parseInteger(std::string_view token, Integer &value) {
-  if (!token.empty() && token.front() == '+')
-    token.remove_prefix(1);
-  if (token.empty())
-    return false;
-  const char *last = token.data() + token.size();
-  const auto [end, code] = std::from_chars(token.data(), last, value);
-  return code == std::errc() && end == last;
+  return parseNumber(token, value);
 }
 
 /// Printable form of a header word for error messages (garbage stays short).
@@ -293,6 +290,11 @@ bool checkPcdHeader(const std::string &path, std::uintmax_t file_size, std::stri
       return false;
     }
     const std::string_view text = trim(line);
+    if (text.empty() && !line.empty()) {
+      // PCL's reader skips empty lines but crashes after one of blanks only.
+      error = "PCD header line " + std::to_string(line_number) + " holds only blanks";
+      return false;
+    }
     if (text.empty() || text.front() == '#')
       continue;
     const std::vector<std::string_view> words = splitWords(text);
@@ -510,6 +512,11 @@ bool parsePlyHeader(std::istream &in, PlyHeader &header, std::string &error) {
     const std::string_view key = words.front();
     if (key == "end_header") {
       break;
+    } else if (key == "obj_info" && !startsWith(line, "obj_info")) {
+      // PCL's reader asserts (and aborts) on an obj_info line that does not
+      // start with the keyword itself.
+      error = where + "obj_info must start the line";
+      return false;
     } else if (key == "comment" || key == "obj_info") {
       continue;
     } else if (key == "format") {
@@ -611,7 +618,17 @@ public:
       const std::size_t start = position_;
       while (position_ < body_.size() && !isBlank(body_[position_]))
         ++position_;
-      return parseDouble(body_.substr(start, position_ - start), value);
+      const std::string_view token = body_.substr(start, position_ - start);
+      // A float property holds what a binary file would: the text rounded
+      // once to float, so ASCII and binary copies match position for position.
+      if (type == PlyType::Float32) {
+        float single;
+        if (!parseNumber(token, single))
+          return false;
+        value = single;
+        return true;
+      }
+      return parseDouble(token, value);
     }
     const std::size_t size = plyTypeSize(type);
     if (position_ + size > body_.size())
@@ -934,8 +951,16 @@ bool loadPlyMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices
             corners.clear();
           for (std::size_t i = 0; ok && i < length; ++i) {
             ok = reader.read(property.value_type, value);
-            if (keep)
-              corners.push_back(static_cast<std::int64_t>(value));
+            if (!ok || !keep)
+              continue;
+            // -1 separates triangle strips; anything else must be an index.
+            if (!(value >= -1 && value <= std::numeric_limits<VertexIndex>::max()) ||
+                value != std::floor(value)) {
+              error = "corrupt PLY file: vertex index " + std::to_string(value) + " in element '" +
+                      element.name + "' record " + std::to_string(r);
+              return false;
+            }
+            corners.push_back(static_cast<std::int64_t>(value));
           }
         } else if (ok && is_vertex) {
           if (static_cast<int>(p) == x)

@@ -5,6 +5,7 @@
 #include <pcl_ms/reconstruct.h>
 #include <pcl_ms/scaffold.h>
 
+#include "far_points.h"
 #include "morton.h"
 #include "threads.h"
 
@@ -44,6 +45,9 @@ std::string Parameters::validate() const {
   else if (bucket_points != 0 && bucket_points < min_bucket_points)
     reason << "bucket size must be 0 (automatic) or at least " << min_bucket_points
            << " points (got " << bucket_points << ")";
+  else if (!(std::isfinite(time_limit_seconds) && time_limit_seconds >= 0))
+    reason << "time limit must be 0 (none) or a number of seconds > 0 (got " << time_limit_seconds
+           << ")";
   else if (grid_buckets < 0 || grid_buckets > max_grid_buckets)
     reason << "grid buckets must be in [0, " << max_grid_buckets << "] (got " << grid_buckets
            << ")";
@@ -113,8 +117,6 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
 
   std::vector<VertexIndex> records;
   records.reserve(count);
-  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d high = -low;
   for (std::size_t i = 0; i < count; ++i) {
     std::size_t record = i;
     if (view.indices) {
@@ -125,15 +127,30 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
       record = static_cast<std::size_t>(index);
     }
     const float *p = recordAt(view.xyz, view.stride, record);
-    if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) {
+    if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))
       records.push_back(static_cast<VertexIndex>(record));
-      const Eigen::Vector3d position(p[0], p[1], p[2]);
-      low = low.cwiseMin(position);
-      high = high.cwiseMax(position);
-    } else {
+    else
       ++result.invalid_points;
-    }
   }
+
+  // Far stray points stay out of the surface, and out of the bounding box
+  // and centre, so that the rest of the cloud is meshed as without them.
+  detail::FarPoints far;
+  {
+    std::vector<Eigen::Vector3f> finite(records.size());
+    for (std::size_t i = 0; i < records.size(); ++i)
+      finite[i] = Eigen::Vector3f(recordAt(view.xyz, view.stride, records[i]));
+    far = detail::findFarPoints(finite);
+  }
+  result.far_points = far.count;
+  if (far.count > 0) {
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < records.size(); ++i)
+      if (!far.is_far[i])
+        records[kept++] = records[i];
+    records.resize(kept);
+  }
+  const Eigen::Vector3d &low = far.low, &high = far.high;
 
   struct Key {
     std::uint64_t morton;
@@ -166,7 +183,7 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
   PreparedPoints prepared;
   if (map_records)
     prepared.prepared_of_record.assign(view.size, not_prepared);
-  const Eigen::Vector3d centre = 0.5 * (low + high);
+  const Eigen::Vector3d &centre = far.median;
   prepared.centre = centre;
   for (std::size_t i = 0; i < keys.size(); ++i) {
     const Key &key = keys[i];
@@ -180,8 +197,7 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
     }
     if (map_records)
       prepared.prepared_of_record[key.record] = static_cast<VertexIndex>(prepared.positions.size());
-    // Centred on the bounding box: circumcentres of far-off points lose
-    // precision otherwise.
+    // Centred: circumcentres of far-off points lose precision otherwise.
     prepared.positions.push_back(
         Eigen::Vector3d(key.coordinates[0], key.coordinates[1], key.coordinates[2]) - centre);
     prepared.user_index.push_back(key.record);
@@ -200,7 +216,8 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
     std::ostringstream reason;
     reason << "need at least 3 distinct valid points, got " << prepared.positions.size() << " ("
            << count << " given, " << result.invalid_points << " NaN/Inf, "
-           << result.duplicate_points << " duplicates)";
+           << result.duplicate_points << " duplicates, " << result.far_points
+           << " far stray points)";
     throw ReconstructionError(reason.str());
   }
   return prepared;
@@ -264,6 +281,7 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
   if (parameters.use_normals && !points.normals)
     throw ReconstructionError("normals were requested but none were given");
 
+  const Deadline deadline(parameters.time_limit_seconds);
   Result result;
   Clock::time_point stage = Clock::now();
   const PreparedPoints prepared =
@@ -279,7 +297,8 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
   std::vector<float> local_scale; // per distinct point
   // Initial triangles are honoured by the one-piece path only.
   if (fixed.empty() && usesBuckets(prepared.positions.size(), parameters)) {
-    BucketedSurface bucketed = meshInBuckets(prepared.positions, normals, parameters);
+    deadline.check("the preparation");
+    BucketedSurface bucketed = meshInBuckets(prepared.positions, normals, parameters, &deadline);
     triangles = std::move(bucketed.triangles);
     local_scale = std::move(bucketed.local_scale);
     result.d_med = bucketed.d_med;
@@ -298,7 +317,9 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
     options.normals = normals;
     options.normal_weight = parameters.normal_weight;
     options.fixed_triangles = fixed.empty() ? nullptr : &fixed;
+    deadline.check("the preparation");
     MedialScaffold scaffold = buildMedialScaffold(prepared.positions, options);
+    deadline.check("the scaffold");
     result.timings.delaunay = scaffold.delaunay_seconds;
     result.timings.scaffold = secondsSince(stage) - scaffold.delaunay_seconds;
     result.planar = scaffold.planar;
@@ -311,7 +332,7 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
     result.peak_memory.scaffold = std::max(result.peak_memory.prepare, peakResidentBytes());
 
     stage = Clock::now();
-    GreedyMesher mesher(scaffold, prepared.positions, parameters);
+    GreedyMesher mesher(scaffold, prepared.positions, parameters, &deadline);
     mesher.run();
     triangles = mesher.triangles();
     local_scale = std::move(scaffold.local_scale);
@@ -323,6 +344,7 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
     result.peak_memory.greedy = std::max(result.peak_memory.scaffold, peakResidentBytes());
   }
 
+  deadline.check("the greedy passes");
   stage = Clock::now();
   // The user's initial triangles must survive the twist repair.
   std::vector<bool> anchored;
@@ -345,6 +367,7 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
                       SideLimit{&local_scale, parameters.rho},
                       anchored.empty() ? nullptr : &anchored, viewpoint ? &*viewpoint : nullptr);
   });
+  deadline.check("the finish");
   // Back to the user's records.
   for (Triangle &triangle : surface.triangles)
     for (VertexIndex &v : triangle)

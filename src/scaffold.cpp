@@ -3,6 +3,7 @@
 #include <pcl_ms/reconstruct.h>
 #include <pcl_ms/scaffold.h>
 
+#include "flat_cells.h"
 #include "threads.h"
 
 #include <CGAL/Delaunay_triangulation_3.h>
@@ -403,8 +404,8 @@ private:
   double shockLength(const Delaunay &delaunay, CellHandle cell, int i, const Circle &circle) const {
     double shortest = std::numeric_limits<double>::infinity();
     for (CellHandle side : {cell, cell->neighbor(i)}) {
-      if (delaunay.is_infinite(side))
-        continue; // that piece is a ray: infinitely long
+      if (delaunay.is_infinite(side) || detail::hasNoCircumcentre(side))
+        continue; // that piece is a ray (or as long as one): infinitely long
       const Eigen::Vector3d voronoi_vertex = toEigen(delaunay.dual(side));
       shortest =
           std::min(shortest, std::abs((voronoi_vertex - circle.centre).dot(circle.unit_normal)));

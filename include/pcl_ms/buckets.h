@@ -6,6 +6,7 @@
 // of work (points in, triangles out), run in parallel.
 #pragma once
 
+#include <pcl_ms/deadline.h>
 #include <pcl_ms/types.h>
 
 #include <Eigen/Core>
@@ -59,8 +60,10 @@ struct BucketOutcome {
 };
 
 /// Scaffold and greedy passes on one unit (no hole filling or orientation:
-/// those run once on the whole surface). Single-threaded.
-BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters);
+/// those run once on the whole surface). Single-threaded. A passed deadline
+/// throws TimeLimitExceeded instead of failing the unit.
+BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters,
+                         const Deadline *deadline = nullptr);
 
 /// Whether reconstruct() meshes `points` distinct points in buckets.
 bool usesBuckets(std::size_t points, const Parameters &parameters);
@@ -79,6 +82,6 @@ struct BucketedSurface {
 /// one entry per point. The result does not depend on the thread count.
 BucketedSurface meshInBuckets(const std::vector<Eigen::Vector3d> &points,
                               const std::vector<Eigen::Vector3f> *normals,
-                              const Parameters &parameters);
+                              const Parameters &parameters, const Deadline *deadline = nullptr);
 
 } // namespace pcl_ms

@@ -4,6 +4,7 @@
 // change the costs; conflicts undo costlier earlier choices.
 #pragma once
 
+#include <pcl_ms/deadline.h>
 #include <pcl_ms/mesh_topology.h>
 #include <pcl_ms/scaffold.h>
 #include <pcl_ms/types.h>
@@ -28,8 +29,9 @@ class GreedyMesher {
 public:
   /// The scaffold must outlive the mesher. It is not const: the type III
   /// candidates that reach pass 2 get their edges numbered in it.
+  /// With a deadline, run() throws TimeLimitExceeded once it has passed.
   GreedyMesher(MedialScaffold &scaffold, const std::vector<Eigen::Vector3d> &points,
-               const Parameters &parameters);
+               const Parameters &parameters, const Deadline *deadline = nullptr);
   ~GreedyMesher();
   GreedyMesher(const GreedyMesher &) = delete;
   GreedyMesher &operator=(const GreedyMesher &) = delete;

@@ -129,6 +129,10 @@ public:
    * as the viewpoint when none was set (default true). */
   void setUseSensorOrigin(bool use) { use_sensor_origin_ = use; }
   bool getUseSensorOrigin() const { return use_sensor_origin_; }
+  /// Gives up after this many seconds: reconstruct() then yields no mesh and
+  /// getErrorMessage() says so. 0 (default) = no limit.
+  void setTimeLimit(double seconds) { parameters_.time_limit_seconds = seconds; }
+  double getTimeLimit() const { return parameters_.time_limit_seconds; }
 
   /** \brief Triangles (indices into the input cloud) that are part of the
    * surface from the start; the method completes the mesh around them

@@ -69,6 +69,9 @@ struct Parameters {
   std::size_t bucket_points = 0;
   /// > 0: cut the bounding box into grid_buckets^3 equal buckets instead.
   int grid_buckets = 0;
+  /// Seconds after which reconstruct() gives up with TimeLimitExceeded (a
+  /// ReconstructionError) and no mesh; 0 = no limit.
+  double time_limit_seconds = 0;
   /// Called with (units done, units in all) as buckets and seams finish,
   /// from worker threads one call at a time.
   std::function<void(std::size_t, std::size_t)> progress;
@@ -136,7 +139,11 @@ struct Result {
   std::size_t invalid_points = 0;   // NaN / Inf, skipped
   std::size_t duplicate_points = 0; // exact repeats, merged onto the first
   std::size_t used_points = 0;      // distinct points that went into the scaffold
-  bool planar = false;              // all points on one plane: 2-D Delaunay used
+  /// Stray points farther from the rest than the cloud's own size, with no
+  /// other point near them: no surface can reach them, so they are left out
+  /// of the scaffold (and stay unreferenced vertices of the cloud).
+  std::size_t far_points = 0;
+  bool planar = false; // all points on one plane: 2-D Delaunay used
 
   std::size_t candidates_type1 = 0, candidates_type2 = 0, candidates_type3 = 0;
   std::size_t candidates_oversize = 0;

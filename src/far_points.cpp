@@ -1,0 +1,100 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "far_points.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace pcl_ms {
+namespace detail {
+namespace {
+
+// Each tail of each axis left out of the central box: small enough that a
+// far cluster of a few percent of the points stays inside it.
+constexpr double tail_fraction = 0.01;
+
+double distanceToBox(const Eigen::Vector3d &p, const Eigen::Vector3d &low,
+                     const Eigen::Vector3d &high) {
+  return (low - p).cwiseMax(p - high).cwiseMax(0.0).norm();
+}
+
+} // namespace
+
+FarPoints findFarPoints(const std::vector<Eigen::Vector3f> &points) {
+  FarPoints far;
+  far.is_far.assign(points.size(), false);
+  if (points.empty())
+    return far;
+  const std::size_t n = points.size();
+  const auto tail = static_cast<std::size_t>(tail_fraction * static_cast<double>(n));
+  Eigen::Vector3d central_low, central_high;
+  std::vector<float> values(n);
+  for (int axis = 0; axis < 3; ++axis) {
+    for (std::size_t i = 0; i < n; ++i)
+      values[i] = points[i][axis];
+    auto at = [&](std::size_t k) {
+      std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k),
+                       values.end());
+      return static_cast<double>(values[k]);
+    };
+    central_low[axis] = at(tail);
+    central_high[axis] = at(n - 1 - tail);
+  }
+  const double size = (central_high - central_low).norm();
+
+  // Only points beyond `size` from the central box can be within `size` of a
+  // candidate (beyond 2 size): every other point is farther than that.
+  std::vector<std::size_t> outside;
+  if (size > 0 && std::isfinite(size))
+    for (std::size_t i = 0; i < n; ++i)
+      if (distanceToBox(points[i].cast<double>(), central_low, central_high) > size)
+        outside.push_back(i);
+  // Swept along x: a neighbour within `size` is within `size` in x.
+  std::sort(outside.begin(), outside.end(),
+            [&](std::size_t a, std::size_t b) { return points[a].x() < points[b].x(); });
+  for (std::size_t k = 0; k < outside.size(); ++k) {
+    const Eigen::Vector3d p = points[outside[k]].cast<double>();
+    if (distanceToBox(p, central_low, central_high) <= 2 * size)
+      continue;
+    bool has_neighbour = false;
+    for (std::size_t j = k + 1; !has_neighbour && j < outside.size(); ++j) {
+      const Eigen::Vector3d q = points[outside[j]].cast<double>();
+      if (q.x() - p.x() > size)
+        break;
+      has_neighbour = (q - p).norm() <= size;
+    }
+    for (std::size_t j = k; !has_neighbour && j-- > 0;) {
+      const Eigen::Vector3d q = points[outside[j]].cast<double>();
+      if (p.x() - q.x() > size)
+        break;
+      has_neighbour = (q - p).norm() <= size;
+    }
+    if (!has_neighbour) {
+      far.is_far[outside[k]] = true;
+      ++far.count;
+    }
+  }
+
+  // The median of the points kept, so that far points change nothing.
+  values.clear();
+  for (int axis = 0; axis < 3; ++axis) {
+    values.clear();
+    for (std::size_t i = 0; i < n; ++i)
+      if (!far.is_far[i])
+        values.push_back(points[i][axis]);
+    auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    far.median[axis] = *middle;
+  }
+  far.low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  far.high = -far.low;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!far.is_far[i]) {
+      far.low = far.low.cwiseMin(points[i].cast<double>());
+      far.high = far.high.cwiseMax(points[i].cast<double>());
+    }
+  return far;
+}
+
+} // namespace detail
+} // namespace pcl_ms
