@@ -2,6 +2,7 @@
 // Tests of pcl_ms/io.h (suites Io*) and of the pcl_ms_reconstruct program
 // (suite App). Every file they write goes to a fresh temporary directory.
 #include "program_test.h"
+#include "synthetic_clouds.h"
 
 #include <pcl_ms/io.h>
 
@@ -774,6 +775,37 @@ TEST_F(App, BucketsWithProgressAndSummary) {
   expectFailure(files + " -bucket_points 50", "bucket size");
   expectFailure(files + " -bucket_points many", "-bucket_points");
   expectFailure(files + " -grid -2", "grid");
+}
+
+TEST_F(App, ViewpointFromThePcdOrGivenOrNone) {
+  // An organized depth frame whose PCD VIEWPOINT is the sensor's position.
+  const auto scan = pcl_ms_tools::oneViewScanOfBoxOnPlane(80, 60);
+  ASSERT_EQ(pcl::io::savePCDFileBinary(path("scan.pcd"), scan.cloud), 0);
+  const Eigen::Vector3d sensor = scan.scene.sensor.cast<double>();
+  auto facingShare = [&] {
+    std::vector<Eigen::Vector3d> vertices;
+    std::vector<pcl_ms::Triangle> triangles;
+    std::string error;
+    EXPECT_TRUE(pcl_ms::loadMesh(path("out.ply"), vertices, triangles, error)) << error;
+    std::size_t facing = 0;
+    for (const pcl_ms::Triangle &t : triangles) {
+      const Eigen::Vector3d &a = vertices[t[0]], &b = vertices[t[1]], &c = vertices[t[2]];
+      facing += (b - a).cross(c - a).dot(sensor - a) > 0;
+    }
+    return triangles.empty() ? 0.0 : static_cast<double>(facing) / triangles.size();
+  };
+  const std::string input = quoted(path("scan.pcd")) + " " + quoted(path("out.ply"));
+  ASSERT_EQ(run(input), 0) << stderr_;
+  EXPECT_TRUE(contains(stdout_, "viewpoint -0.8,-1.6,1.4 (sensor origin)")) << stdout_;
+  EXPECT_GE(facingShare(), 0.99);
+  // From below the ground the surface turns its back to the sensor.
+  ASSERT_EQ(run(input + " -viewpoint 0,0,-5"), 0) << stderr_;
+  EXPECT_TRUE(contains(stdout_, "viewpoint 0,0,-5")) << stdout_;
+  EXPECT_LE(facingShare(), 0.01);
+  ASSERT_EQ(run(input + " -no_viewpoint"), 0) << stderr_;
+  EXPECT_FALSE(contains(stdout_, "viewpoint")) << stdout_;
+  expectFailure(input + " -viewpoint 1,2", "-viewpoint");
+  expectFailure(input + " -viewpoint 0,nan,1", "viewpoint must be finite");
 }
 
 TEST_F(App, HelpExitsCleanly) {
