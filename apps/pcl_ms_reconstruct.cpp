@@ -93,9 +93,8 @@ void printHelp(const char *program) {
 /// Collects the two file names and checks every option and its value.
 /// Numbers are read with PCL's parser, which rejects trailing garbage.
 bool parseArguments(int argc, char **argv, Options &options, std::string &error) {
-  const std::vector<std::string> value_options = {"-rho",           "-fill_holes", "-threads",
-                                                  "-bucket_points", "-grid",       "-viewpoint",
-                                                  "-time_limit"};
+  const std::vector<std::string> value_options = {
+      "-rho", "-fill_holes", "-threads", "-bucket_points", "-grid", "-viewpoint", "-time_limit"};
   std::vector<std::string> positional;
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
