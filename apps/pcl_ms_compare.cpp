@@ -389,8 +389,7 @@ int run(int argc, char **argv) {
   }
   // A depth frame's sensor is its viewpoint, as for the PCL class.
   PeerSettings settings;
-  if (blob.height > 1 || sensor_origin.head<3>() != Eigen::Vector3f::Zero())
-    settings.viewpoint = {{sensor_origin[0], sensor_origin[1], sensor_origin[2]}};
+  settings.viewpoint = sensorViewpoint(blob, sensor_origin);
   pcl::PointCloud<pcl::PointXYZ> points;
   const std::size_t skipped = finitePoints(blob, points);
   blob = pcl::PCLPointCloud2(); // only the positions are needed from here on

@@ -189,17 +189,15 @@ bool fileStep(const char *verb, const std::string &path, bool verbose, double &m
 /// Converts the cloud to PointT, meshes it and returns the polygons, which
 /// index the cloud's points directly.
 template <typename PointT>
-bool reconstructAs(const pcl::PCLPointCloud2 &cloud, const Eigen::Vector4f &sensor_origin,
-                   const pcl_ms::Parameters &parameters, bool use_sensor_origin,
+bool reconstructAs(const pcl::PCLPointCloud2 &cloud, const pcl_ms::Parameters &parameters,
                    std::vector<pcl::Vertices> &polygons, pcl_ms::Result &result,
                    std::string &error) {
   auto points = pcl::make_shared<pcl::PointCloud<PointT>>();
   pcl::fromPCLPointCloud2(cloud, *points);
-  points->sensor_origin_ = sensor_origin;
   pcl::MedialScaffoldReconstruction<PointT> reconstruction;
   reconstruction.setInputCloud(points);
   reconstruction.setParameters(parameters);
-  reconstruction.setUseSensorOrigin(use_sensor_origin);
+  reconstruction.setUseSensorOrigin(false); // run() decided the viewpoint
   pcl::PolygonMesh mesh;
   {
     SilencePclMessages silence;
@@ -348,6 +346,8 @@ int run(int argc, char **argv) {
     print_info("Available dimensions: ");
     print_value("%s\n", fieldNames(cloud).c_str());
   }
+  if (!parameters.viewpoint && !options.no_viewpoint)
+    parameters.viewpoint = pcl_ms_tools::sensorViewpoint(cloud, sensor_origin);
   if (options.normals && !pcl_ms::hasNormals(cloud))
     return fail(kBadArguments, "-normals was given but " + options.input +
                                    " has no float normal_x, normal_y, normal_z fields");
@@ -363,12 +363,8 @@ int run(int argc, char **argv) {
     print_value("%d", options.threads);
     if (parameters.viewpoint) {
       print_info(", viewpoint ");
-      print_value("%g,%g,%g", (*parameters.viewpoint)[0], (*parameters.viewpoint)[1],
-                  (*parameters.viewpoint)[2]);
-    } else if ((cloud.height > 1 || sensor_origin.head<3>() != Eigen::Vector3f::Zero()) &&
-               !options.no_viewpoint) {
-      print_info(", viewpoint ");
-      print_value("%g,%g,%g (sensor origin)", sensor_origin[0], sensor_origin[1], sensor_origin[2]);
+      print_value("%g,%g,%g%s", (*parameters.viewpoint)[0], (*parameters.viewpoint)[1],
+                  (*parameters.viewpoint)[2], options.viewpoint.empty() ? " (sensor origin)" : "");
     }
     print_info(" ");
   }
@@ -381,10 +377,8 @@ int run(int argc, char **argv) {
   pcl_ms::Result result;
   const bool reconstructed =
       options.normals
-          ? reconstructAs<pcl::PointNormal>(cloud, sensor_origin, parameters, !options.no_viewpoint,
-                                            mesh.polygons, result, error)
-          : reconstructAs<pcl::PointXYZ>(cloud, sensor_origin, parameters, !options.no_viewpoint,
-                                         mesh.polygons, result, error);
+          ? reconstructAs<pcl::PointNormal>(cloud, parameters, mesh.polygons, result, error)
+          : reconstructAs<pcl::PointXYZ>(cloud, parameters, mesh.polygons, result, error);
   const double reconstruct_ms = timer.toc();
   if (!reconstructed) {
     if (verbose)

@@ -54,3 +54,14 @@ pcl_ms::PointView pointView(const pcl::PointCloud<pcl::PointXYZ> &points) {
 }
 
 } // namespace pcl_ms_tools
+
+namespace pcl_ms_tools {
+
+std::optional<std::array<double, 3>> sensorViewpoint(const pcl::PCLPointCloud2 &cloud,
+                                                     const Eigen::Vector4f &sensor_origin) {
+  if (cloud.height <= 1 && sensor_origin.head<3>() == Eigen::Vector3f::Zero())
+    return std::nullopt;
+  return std::array<double, 3>{sensor_origin[0], sensor_origin[1], sensor_origin[2]};
+}
+
+} // namespace pcl_ms_tools

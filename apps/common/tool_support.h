@@ -12,7 +12,9 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <array>
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,6 +49,12 @@ private:
 std::size_t finitePoints(const pcl::PCLPointCloud2 &cloud, pcl::PointCloud<pcl::PointXYZ> &points);
 
 std::vector<Eigen::Vector3d> positions(const pcl::PointCloud<pcl::PointXYZ> &points);
+
+/// The viewpoint the PCL class would take from a loaded cloud: its sensor
+/// origin (a PCD's VIEWPOINT) when the cloud is organized (a depth frame)
+/// or the origin is not zero; none otherwise.
+std::optional<std::array<double, 3>> sensorViewpoint(const pcl::PCLPointCloud2 &cloud,
+                                                     const Eigen::Vector4f &sensor_origin);
 
 /// The core's view of the cloud's points (no copy: valid while they are).
 pcl_ms::PointView pointView(const pcl::PointCloud<pcl::PointXYZ> &points);
