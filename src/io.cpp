@@ -932,6 +932,10 @@ bool loadPlyMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices
     }
     if (is_vertex)
       vertices.reserve(element.count);
+    // Records without properties take no bytes: billions of them would be
+    // a long loop that reads nothing (a fuzz finding).
+    if (element.properties.empty())
+      continue;
 
     for (std::uint64_t r = 0; r < element.count; ++r) {
       Eigen::Vector3d point = Eigen::Vector3d::Zero();
