@@ -44,6 +44,9 @@ constexpr std::size_t cells_per_chunk = 4096;
 constexpr double scale_turn_fraction = 0.25;
 // Rounds of the median over those triangles' corners.
 constexpr int scale_smoothing_rounds = 2;
+// The final round raises a point's scale to the largest around it, at most
+// this many times its own median.
+constexpr float scale_raise_cap = 2.0f;
 
 // A vanishing shock length (co-spherical points) must not divide by zero.
 constexpr double min_shock_length_fraction = 1e-6;
@@ -257,6 +260,10 @@ private:
   /// 2. The scale: the median of the own values of the point and of the
   ///    corners of the triangles that made up its quarter turn, so that one
   ///    odd point does not decide; then the same median of these medians.
+  ///    Last, the largest of these over the same neighbours, capped at twice
+  ///    the point's own: medians of small neighbourhoods keep the tight
+  ///    clusters of a random sample at a third of the scale around them,
+  ///    and the surface had holes there.
   /// 3. One factor for the whole cloud makes the median scale the median
   ///    Gabriel circumradius, d_med: on a uniform sample every scale is about
   ///    d_med, and rho keeps the meaning it had with one global length.
@@ -377,6 +384,19 @@ private:
       });
       previous = scale;
     }
+    // Then the raise, capped so that a dense point beside sparse strays (a
+    // scan's silhouette) does not take their scale.
+    forEachChunk(n, options_.num_threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+      for (std::size_t v = begin; v < end; ++v) {
+        float largest = previous[v];
+        for (std::uint32_t slot = offsets[v]; slot < offsets[v + 1]; ++slot)
+          if (radii_at[slot] <= own[v]) {
+            const auto [b, c] = cornersOf(slot);
+            largest = std::max({largest, previous[b], previous[c]});
+          }
+        scale[v] = std::min(largest, scale_raise_cap * previous[v]);
+      }
+    });
     previous = {};
     radii_at = {};
     corners_at = {};
