@@ -140,6 +140,12 @@ std::vector<Triangle> triangulateLoop(const std::vector<VertexIndex> &loop,
   using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, DataStructure>;
 
   const std::size_t m = loop.size();
+  // A loop is one hole: like a triangle against its largest corner scale,
+  // its filling is held to the largest scale on its rim.
+  float rim_scale = 0;
+  for (VertexIndex v : loop)
+    rim_scale = std::max(rim_scale, (*limit.point_scale)[v]);
+  const double max_side = limit.rho * rim_scale;
   std::vector<std::pair<Kernel::Point_3, std::size_t>> input;
   for (std::size_t i = 0; i < m; ++i) {
     const Eigen::Vector3d &p = points[loop[i]];
@@ -187,8 +193,7 @@ std::vector<Triangle> triangulateLoop(const std::vector<VertexIndex> &loop,
         // keep the greedy's size limit, or fillings would reach across
         // concave spots.
         if (shape.compactness <= 0 ||
-            (m > max_unlimited_loop_edges &&
-             shape.longest_side >= limit.maxSide({loop[i], loop[k], loop[j]})))
+            (m > max_unlimited_loop_edges && shape.longest_side >= max_side))
           continue;
         const double cost =
             best[i][k] + best[k][j] + shape.perimeter / (shape.compactness * shape.compactness);
@@ -614,15 +619,16 @@ bool reversesWithin(std::uint32_t start, int max_steps, const std::vector<Manifo
   return reverses;
 }
 
-/// orientComponents() given the mesh's manifold pairs.
 /// Where orientPairs() found twists to repair: triangles at whose most
 /// crumpled corner the fan goes (sharp folds), and triangles that go alone
-/// (the two of an inconsistent edge that closes a local twist).
+/// (the two of an inconsistent edge that closes a local twist; with a
+/// viewpoint, the more edge-on one of any inconsistent edge).
 struct TwistSpots {
   std::vector<std::uint32_t> fans, triangles;
   bool empty() const { return fans.empty() && triangles.empty(); }
 };
 
+/// orientComponents() given the mesh's manifold pairs.
 TwistSpots orientPairs(std::vector<Triangle> &triangles, const std::vector<ManifoldPair> &pairs,
                        const std::vector<Eigen::Vector3d> &points,
                        std::vector<std::uint32_t> &triangle_component,
@@ -745,6 +751,21 @@ TwistSpots orientPairs(std::vector<Triangle> &triangles, const std::vector<Manif
     // The long walk is tried until one conflict of a component fails it:
     // that component holds a real twist, and the walks would cost the
     // component's size each.
+    // Seen from one point a surface cannot fold over itself: of the two
+    // triangles of a fold, the one seen more edge-on goes (the other is the
+    // surface the sensor saw). Cutting fans or both triangles there left
+    // office1.pcd with 797 pieces and 1,108 loops instead of 290 and 705.
+    auto moreEdgeOn = [&](const ManifoldPair &pair) {
+      auto facing = [&](std::uint32_t t) {
+        const Eigen::Vector3d &a = points[triangles[t][0]], &b = points[triangles[t][1]],
+                              &c = points[triangles[t][2]];
+        const Eigen::Vector3d normal = (b - a).cross(c - a);
+        const Eigen::Vector3d to_viewpoint = *viewpoint - (a + b + c) / 3;
+        const double lengths = normal.norm() * to_viewpoint.norm();
+        return lengths > 0 ? std::abs(normal.dot(to_viewpoint)) / lengths : 0.0;
+      };
+      return facing(pair.first) < facing(pair.second) ? pair.first : pair.second;
+    };
     std::vector<std::uint8_t> reached(triangles.size(), 0);
     std::vector<bool> holds_real_twist(members.size(), false);
     for (std::uint32_t p = 0; p < pairs.size(); ++p) {
@@ -764,9 +785,11 @@ TwistSpots orientPairs(std::vector<Triangle> &triangles, const std::vector<Manif
         holds_real_twist[component] = true;
         return false;
       };
-      if (bending[p] > max_untwist_bending)
+      if (viewpoint)
+        twisted_spots.triangles.push_back(moreEdgeOn(pairs[p]));
+      else if (bending[p] > max_untwist_bending)
         twisted_spots.fans.push_back(pairs[p].first);
-      else if (viewpoint || localTwist()) {
+      else if (localTwist()) {
         twisted_spots.triangles.push_back(pairs[p].first);
         twisted_spots.triangles.push_back(pairs[p].second);
       }
@@ -870,9 +893,9 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
   TwistSpots twisted = fillThenOrient(fill_holes_max_edges, nullptr);
   for (int round = 0; round < max_untwist_rounds && !twisted.empty(); ++round) {
     std::vector<bool> touched;
-    // The two triangles of a local twist's inconsistent edge go alone:
-    // cutting whole fans there split sparse scans into many pieces (car6:
-    // 116 components instead of 68).
+    // The lone triangles go first (see TwistSpots): cutting whole fans at
+    // every twist split sparse scans into many pieces (car6: 116
+    // components instead of 68).
     std::vector<bool> drop(triangles.size(), false);
     for (std::uint32_t t : twisted.triangles)
       drop[t] = !anchored_vertices ||

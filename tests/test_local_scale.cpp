@@ -195,6 +195,34 @@ TEST(Viewpoint, NoisyScanIsOrientableAndMostlyFacesItsSensor) {
   EXPECT_GE(facingShare(points, result.triangles, scan.scene.sensor.cast<double>()), 0.9);
 }
 
+TEST(Viewpoint, FoldsInANoisyFrameCostOnlyTheirEdgeOnTriangle) {
+  // At 320 x 240 pixels the same range noise is twice as large against the
+  // pixel spacing, and the greedy folds the surface in many places. Seen
+  // from the sensor, only the more edge-on triangle of a fold goes; cutting
+  // both, or whole fans, left the largest piece with 92.7 % of the points
+  // (174 pieces).
+  const auto scan =
+      pcl_ms_tools::oneViewScanOfBoxOnPlane(320, 240, pcl_ms_tools::kSyntheticSeed, 0.0015);
+  const pcl_ms::Result result = meshScan(scan);
+  const std::vector<Eigen::Vector3d> points = positions(scan.cloud);
+  const MeshTopologyReport topology = pcl_ms::analyzeMesh(points, result.triangles);
+  expectCleanManifold(topology);
+  EXPECT_EQ(result.numberOfNonOrientableComponents(), 0u);
+  std::vector<std::size_t> points_per_component(result.component_orientable.size(), 0);
+  std::vector<bool> counted(points.size(), false);
+  for (std::size_t t = 0; t < result.triangles.size(); ++t)
+    for (pcl_ms::VertexIndex v : result.triangles[t])
+      if (!counted[v]) {
+        counted[v] = true;
+        ++points_per_component[result.triangle_component[t]];
+      }
+  const std::size_t finite = std::count_if(points.begin(), points.end(),
+                                           [](const Eigen::Vector3d &p) { return p.allFinite(); });
+  ASSERT_FALSE(points_per_component.empty());
+  EXPECT_GE(*std::max_element(points_per_component.begin(), points_per_component.end()),
+            0.97 * finite);
+}
+
 TEST(Viewpoint, ExplicitViewpointWinsAndIsValidated) {
   const auto scan = pcl_ms_tools::oneViewScanOfBoxOnPlane();
   pcl_ms::Parameters parameters;
