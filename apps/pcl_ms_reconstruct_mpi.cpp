@@ -89,12 +89,13 @@ void printRankTable(const std::vector<RankFigures> &figures) {
   pcl_ms_tools::printRow("peak RSS, all ranks", "%10.1f", total_peak);
 }
 
-/// Broadcasts rank 0's points, meshes them on every rank and returns rank
-/// 0's polygons (empty elsewhere).
+/// Broadcasts rank 0's points and meshes them on every rank; rank 0 gets
+/// the triangles. The points are freed on return, before rank 0 builds the
+/// output mesh.
 template <typename PointT>
 pcl_ms::Result meshAs(const Job &job, const pcl::PCLPointCloud2 &cloud,
-                      const pcl_ms::Parameters &parameters, pcl_ms_mpi::MpiBucketExchange &exchange,
-                      std::vector<pcl::Vertices> &polygons) {
+                      const pcl_ms::Parameters &parameters,
+                      pcl_ms_mpi::MpiBucketExchange &exchange) {
   pcl::PointCloud<PointT> points;
   if (job.rank == 0) {
     SilencePclMessages silence;
@@ -117,16 +118,11 @@ pcl_ms::Result meshAs(const Job &job, const pcl::PCLPointCloud2 &cloud,
       view.normal_stride = sizeof(PointT);
     }
   }
-  pcl_ms::Result result;
   try {
-    result = pcl_ms::reconstruct(view, parameters, exchange);
+    return pcl_ms::reconstruct(view, parameters, exchange);
   } catch (const std::exception &error) {
     abortJob(job, kReconstructionFailure, std::string("reconstruction failed: ") + error.what());
   }
-  polygons.resize(result.triangles.size());
-  for (std::size_t t = 0; t < result.triangles.size(); ++t)
-    polygons[t].vertices.assign(result.triangles[t].begin(), result.triangles[t].end());
-  return result;
 }
 
 int run(const Job &job, int argc, char **argv) {
@@ -186,10 +182,12 @@ int run(const Job &job, int argc, char **argv) {
       std::fprintf(stderr, "  all ranks: %s done, %.1f s elapsed\n", stage.c_str(),
                    secondsSinceStart());
   });
-  std::vector<pcl::Vertices> polygons;
-  const pcl_ms::Result result =
-      options.normals ? meshAs<pcl::PointNormal>(job, cloud, parameters, exchange, polygons)
-                      : meshAs<pcl::PointXYZ>(job, cloud, parameters, exchange, polygons);
+  const pcl_ms::Result result = options.normals
+                                    ? meshAs<pcl::PointNormal>(job, cloud, parameters, exchange)
+                                    : meshAs<pcl::PointXYZ>(job, cloud, parameters, exchange);
+  std::vector<pcl::Vertices> polygons(result.triangles.size());
+  for (std::size_t t = 0; t < result.triangles.size(); ++t)
+    polygons[t].vertices.assign(result.triangles[t].begin(), result.triangles[t].end());
   const double reconstruct_seconds = secondsSinceStart();
   if (verbose) {
     print_info("[done, ");
@@ -215,6 +213,11 @@ int run(const Job &job, int argc, char **argv) {
   if (verbose) {
     pcl_ms_tools::printReconstructReport(result, load_ms, save_ms);
     printRankTable(figures);
+    // Where rank 0's memory goes: it alone holds the file and finishes.
+    const pcl_ms::StagePeakMemory &peaks = result.peak_memory;
+    pcl_ms_tools::printRow("rank 0 MB, prepared", "%10.1f", peaks.prepare / 1048576.0);
+    pcl_ms_tools::printRow("rank 0 MB, meshed", "%10.1f", peaks.greedy / 1048576.0);
+    pcl_ms_tools::printRow("rank 0 MB, finished", "%10.1f", peaks.finish / 1048576.0);
   }
   return kSuccess;
 }
