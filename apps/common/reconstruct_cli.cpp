@@ -4,7 +4,10 @@
 #include <pcl_ms/buckets.h>
 #include <pcl_ms/io.h>
 
+#include <pcl/PolygonMesh.h>
 #include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+#include <pcl/console/time.h>
 
 #include <algorithm>
 #include <cstdio>

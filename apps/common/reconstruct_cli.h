@@ -10,8 +10,6 @@
 
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/Vertices.h>
-#include <pcl/console/print.h>
-#include <pcl/console/time.h>
 
 #include <chrono>
 #include <string>
