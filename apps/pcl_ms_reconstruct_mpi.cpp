@@ -5,9 +5,9 @@
 // Rank 0 reads the cloud and broadcasts its points (the other ranks need no
 // access to the file). Every rank prepares the points and builds the bucket
 // tree the same way; each meshes its own buckets and seam zones, and the
-// triangles a zone needs go to the rank that owns it (pcl_ms::BucketExchange,
-// docs/algorithm.md#buckets). Rank 0 ends with the whole surface, finishes it
-// (hole filling, orientation) and writes the mesh.
+// triangles a zone needs go to the rank that owns it (pcl_ms::BucketExchange;
+// docs/algorithm.md, "Across processes"). Rank 0 ends with the whole
+// surface, finishes it (hole filling, orientation) and writes the mesh.
 //
 // Failures: what every rank would see the same way (arguments, the file) is
 // agreed on and every rank exits with the same code; a failure on one rank

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // pcl_ms::BucketExchange without MPI: threads stand in for processes, so
-// the sharing of buckets and seams (docs/algorithm.md#across-processes-pcl_ms_reconstruct_mpi)
+// the sharing of buckets and seams (docs/algorithm.md, "Across processes")
 // is checked in every build, sanitizers included.
 #include "test_support.h"
 

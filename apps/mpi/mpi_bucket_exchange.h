@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // pcl_ms::BucketExchange over MPI: the buckets and seam zones of one cloud
-// shared among the ranks of a communicator (docs/algorithm.md#buckets).
+// shared among the ranks of a communicator (docs/algorithm.md, "Across processes").
 #pragma once
 
 #include <pcl_ms/buckets.h>

@@ -80,11 +80,12 @@ struct BucketedSurface {
 };
 
 /// Shares the buckets and seam zones of meshInBuckets among cooperating
-/// processes that all hold the same points (docs/algorithm.md#buckets). The
-/// default is one process doing everything. Process r owns a contiguous
-/// range of leaves (bucketOwner) and every zone whose first leaf it owns, so
-/// process 0 owns the root and ends up with the whole surface. Every call
-/// is collective: all processes make it, in the same order.
+/// processes that all hold the same points (docs/algorithm.md, "Across
+/// processes"). The default is one process doing everything. Process r owns
+/// a contiguous range of leaves (bucketOwner) and every zone whose first
+/// leaf it owns, so process 0 owns the root and ends up with the whole
+/// surface. Every call is collective: all processes make it, in the same
+/// order.
 class BucketExchange {
 public:
   virtual ~BucketExchange() = default;
