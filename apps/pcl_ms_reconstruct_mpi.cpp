@@ -72,18 +72,20 @@ double peakResidentMegabytes() {
 
 /// What each rank reports to rank 0 for the summary.
 struct RankFigures {
-  double peak_mb = 0, reconstruct_seconds = 0, sent_mb = 0, received_mb = 0;
+  double peak_mb = 0, prepared_mb = 0, reconstruct_seconds = 0, sent_mb = 0, received_mb = 0;
 };
 
 void printRankTable(const std::vector<RankFigures> &figures) {
   print_info("\nRanks:\n");
-  print_info("  %-6s %14s %16s %14s %14s\n", "rank", "peak RSS (MB)", "reconstruct (s)",
-             "sent (MB)", "received (MB)");
+  // "prepared": the peak once the points are prepared, before any bucket:
+  // what every rank pays for holding the whole cloud.
+  print_info("  %-6s %14s %14s %16s %14s %14s\n", "rank", "peak RSS (MB)", "prepared (MB)",
+             "reconstruct (s)", "sent (MB)", "received (MB)");
   double total_peak = 0;
   for (std::size_t r = 0; r < figures.size(); ++r) {
     print_info("  %-6zu ", r);
-    print_value("%14.1f %16.2f %14.1f %14.1f\n", figures[r].peak_mb, figures[r].reconstruct_seconds,
-                figures[r].sent_mb, figures[r].received_mb);
+    print_value("%14.1f %14.1f %16.2f %14.1f %14.1f\n", figures[r].peak_mb, figures[r].prepared_mb,
+                figures[r].reconstruct_seconds, figures[r].sent_mb, figures[r].received_mb);
     total_peak += figures[r].peak_mb;
   }
   pcl_ms_tools::printRow("peak RSS, all ranks", "%10.1f", total_peak);
@@ -201,8 +203,8 @@ int run(const Job &job, int argc, char **argv) {
   if (on_rank_zero)
     status = pcl_ms_tools::saveReconstructedMesh(options, std::move(cloud), std::move(polygons),
                                                  save_ms, error);
-  RankFigures mine{peakResidentMegabytes(), reconstruct_seconds,
-                   static_cast<double>(exchange.bytesSent()) / (1 << 20),
+  RankFigures mine{peakResidentMegabytes(), result.peak_memory.prepare / 1048576.0,
+                   reconstruct_seconds, static_cast<double>(exchange.bytesSent()) / (1 << 20),
                    static_cast<double>(exchange.bytesReceived()) / (1 << 20)};
   std::vector<RankFigures> figures(on_rank_zero ? job.ranks : 0);
   MPI_Gather(&mine, sizeof(RankFigures), MPI_BYTE, figures.data(), sizeof(RankFigures), MPI_BYTE, 0,
@@ -213,9 +215,8 @@ int run(const Job &job, int argc, char **argv) {
   if (verbose) {
     pcl_ms_tools::printReconstructReport(result, load_ms, save_ms);
     printRankTable(figures);
-    // Where rank 0's memory goes: it alone holds the file and finishes.
+    // Where rank 0's memory goes beyond the others': it alone finishes.
     const pcl_ms::StagePeakMemory &peaks = result.peak_memory;
-    pcl_ms_tools::printRow("rank 0 MB, prepared", "%10.1f", peaks.prepare / 1048576.0);
     pcl_ms_tools::printRow("rank 0 MB, meshed", "%10.1f", peaks.greedy / 1048576.0);
     pcl_ms_tools::printRow("rank 0 MB, finished", "%10.1f", peaks.finish / 1048576.0);
   }

@@ -26,7 +26,7 @@ if [[ -z $seams || $seams -lt 3 ]]; then
   exit 1
 fi
 # Every rank reported its peak memory.
-reported=$(awk '/^ *[0-9]+ +[0-9.]+ +[0-9.]+ +[0-9.]+ +[0-9.]+ *$/' "$work/log.txt" | wc -l)
+reported=$(grep -cE '^ *[0-9]+( +[0-9.]+){5} *$' "$work/log.txt" || true)
 if [[ $reported != "$ranks" ]]; then
   cat "$work/log.txt"
   echo "FAIL: $reported rank rows in the summary, expected $ranks"
