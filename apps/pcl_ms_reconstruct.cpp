@@ -3,188 +3,30 @@
 // pcl::MedialScaffoldReconstruction and saves the mesh, in the manner of
 // PCL's own command-line tools. On any failure it prints exactly one line,
 // "error: <reason>", on stderr and exits non-zero, so scripts can rely on it.
+#include "reconstruct_cli.h"
 #include "tool_support.h"
 
-#include <pcl_ms/buckets.h>
-#include <pcl_ms/io.h>
 #include <pcl_ms/medial_scaffold_reconstruction.h>
 
-#include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
 #include <pcl/conversions.h>
 #include <pcl/point_types.h>
 
-#include <algorithm>
-#include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include <unistd.h>
-
 namespace {
 
-using pcl::console::print_highlight;
 using pcl::console::print_info;
 using pcl::console::print_value;
 using pcl_ms_tools::fail;
 using pcl_ms_tools::kBadArguments;
-using pcl_ms_tools::kIoFailure;
 using pcl_ms_tools::kReconstructionFailure;
 using pcl_ms_tools::kSuccess;
 using pcl_ms_tools::SilencePclMessages;
-
-struct Options {
-  std::string input, output;
-  // Defaults come from the library so that the tool and the class agree.
-  double rho = pcl_ms::Parameters().rho;
-  int fill_holes = pcl_ms::Parameters().fill_holes_max_edges;
-  bool normals = false;
-  int threads = 1;
-  unsigned int bucket_points = 0; // 0: automatic
-  int grid = 0;
-  std::vector<double> viewpoint; // empty, or x, y, z
-  bool no_viewpoint = false;
-  double time_limit = 0; // seconds, 0: none
-  bool quiet = false;
-  bool help = false;
-};
-
-void printHelp(const char *program) {
-  print_info("Meshes a point cloud by greedy gap transforms on its medial scaffold.\n\n");
-  print_info("Usage: %s input output [options]\n\n", program);
-  print_info("  input   point cloud: .pcd, .ply, .xyz or .txt (x y z [nx ny nz] per line)\n");
-  print_info("  output  mesh: .ply (binary), .vtk or .obj; its vertices are the input points, in\n"
-             "          order, with colours and normals where the format can hold them\n\n");
-  print_info("Options:\n");
-  print_info("  -rho X          no triangle side reaches X times the local scale, the typical\n"
-             "                  circumradius of the surface triangles where it lies (default ");
-  print_value("%g", pcl_ms::Parameters().rho);
-  print_info(")\n");
-  print_info("  -fill_holes K   close boundary loops of at most K edges, 0 = off (default ");
-  print_value("%d", pcl_ms::Parameters().fill_holes_max_edges);
-  print_info(")\n");
-  print_info("  -normals        use the cloud's normal_x/y/z fields to guide the surface\n");
-  print_info("  -threads N      threads for the parallel stages, 0 = all cores (default ");
-  print_value("1");
-  print_info(")\n");
-  print_info("  -bucket_points M  mesh clouds larger than M points in buckets of about M points,\n"
-             "                  stitched together; 0 = automatic: buckets of ");
-  print_value("%zu", pcl_ms::default_bucket_points);
-  print_info(" above ");
-  print_value("%zu", pcl_ms::automatic_bucketing_threshold);
-  print_info(" points (default 0)\n");
-  print_info("  -grid N         cut the bounding box into N x N x N buckets instead\n");
-  print_info("  -viewpoint X,Y,Z  where a one-view scan was taken from: open surfaces face it\n"
-             "                  and are never left one-sided (default: the sensor origin (PCD\n"
-             "                  VIEWPOINT) of an organized cloud, i.e. a depth frame, or a\n"
-             "                  non-zero one; none for other clouds)\n");
-  print_info("  -no_viewpoint   no viewpoint, even for an organized cloud\n");
-  print_info("  -time_limit S   give up after S seconds with an error and no output file,\n"
-             "                  0 = no limit (default 0)\n");
-  print_info("  -q              quiet: print nothing but errors\n");
-  print_info("  -h              this help\n\n");
-  print_info("Exit status: 0 success, 1 bad arguments, 2 file error, 3 reconstruction failed.\n");
-}
-
-/// Collects the two file names and checks every option and its value.
-/// Numbers are read with PCL's parser, which rejects trailing garbage.
-bool parseArguments(int argc, char **argv, Options &options, std::string &error) {
-  const std::vector<std::string> value_options = {
-      "-rho", "-fill_holes", "-threads", "-bucket_points", "-grid", "-viewpoint", "-time_limit"};
-  std::vector<std::string> positional;
-  for (int i = 1; i < argc; ++i) {
-    const std::string argument = argv[i];
-    if (argument == "-h" || argument == "--help") {
-      options.help = true;
-    } else if (argument == "-normals") {
-      options.normals = true;
-    } else if (argument == "-q") {
-      options.quiet = true;
-    } else if (argument == "-no_viewpoint") {
-      options.no_viewpoint = true;
-    } else if (std::find(value_options.begin(), value_options.end(), argument) !=
-               value_options.end()) {
-      if (i + 1 >= argc) {
-        error = argument + " needs a value";
-        return false;
-      }
-      ++i; // the value itself is parsed below
-    } else if (argument.size() > 1 && argument[0] == '-') {
-      error = "unknown option '" + argument + "' (see -h)";
-      return false;
-    } else {
-      positional.push_back(argument);
-    }
-  }
-  if (options.help)
-    return true;
-
-  const auto badValue = [&](const char *option) {
-    const int index = pcl::console::find_argument(argc, argv, option);
-    error = std::string(option) + ": '" + argv[index + 1] + "' is not a valid number";
-    return false;
-  };
-  if (pcl::console::find_argument(argc, argv, "-rho") >= 0 &&
-      pcl::console::parse_argument(argc, argv, "-rho", options.rho) < 0)
-    return badValue("-rho");
-  if (pcl::console::find_argument(argc, argv, "-fill_holes") >= 0 &&
-      pcl::console::parse_argument(argc, argv, "-fill_holes", options.fill_holes) < 0)
-    return badValue("-fill_holes");
-  if (pcl::console::find_argument(argc, argv, "-threads") >= 0 &&
-      pcl::console::parse_argument(argc, argv, "-threads", options.threads) < 0)
-    return badValue("-threads");
-  if (pcl::console::find_argument(argc, argv, "-bucket_points") >= 0 &&
-      pcl::console::parse_argument(argc, argv, "-bucket_points", options.bucket_points) < 0)
-    return badValue("-bucket_points");
-  if (pcl::console::find_argument(argc, argv, "-grid") >= 0 &&
-      pcl::console::parse_argument(argc, argv, "-grid", options.grid) < 0)
-    return badValue("-grid");
-  if (const int index = pcl::console::find_argument(argc, argv, "-viewpoint"); index >= 0) {
-    pcl::console::parse_x_arguments(argc, argv, "-viewpoint", options.viewpoint);
-    if (options.viewpoint.size() != 3) {
-      error = std::string("-viewpoint: '") + argv[index + 1] + "' is not three numbers x,y,z";
-      return false;
-    }
-  }
-  if (pcl::console::find_argument(argc, argv, "-time_limit") >= 0 &&
-      pcl::console::parse_argument(argc, argv, "-time_limit", options.time_limit) < 0)
-    return badValue("-time_limit");
-
-  if (positional.size() != 2) {
-    error = "expected input and output file names, got " + std::to_string(positional.size()) +
-            " (see -h)";
-    return false;
-  }
-  options.input = positional[0];
-  options.output = positional[1];
-  return true;
-}
-
-/// Loads or saves with PCL's own console messages silenced (our one-line
-/// error says it all), timing the step and announcing it in PCL tool style.
-template <typename Step>
-bool fileStep(const char *verb, const std::string &path, bool verbose, double &milliseconds,
-              const Step &step) {
-  if (verbose) {
-    print_highlight("%s ", verb);
-    print_value("%s ", path.c_str());
-  }
-  pcl::console::TicToc timer;
-  timer.tic();
-  bool succeeded = false;
-  {
-    SilencePclMessages silence;
-    succeeded = step();
-  }
-  milliseconds = timer.toc();
-  if (!succeeded && verbose)
-    print_info("[failed]\n");
-  return succeeded;
-}
 
 /// Converts the cloud to PointT, meshes it and returns the polygons, which
 /// index the cloud's points directly.
@@ -212,173 +54,46 @@ bool reconstructAs(const pcl::PCLPointCloud2 &cloud, const pcl_ms::Parameters &p
   return true;
 }
 
-std::string fieldNames(const pcl::PCLPointCloud2 &cloud) {
-  std::string names;
-  for (const pcl::PCLPointField &field : cloud.fields)
-    names += (names.empty() ? "" : " ") + field.name;
-  return names;
-}
-
-void printRow(const char *label, const char *format, double value) {
-  print_info("  %-22s", label);
-  print_value(format, value);
-  print_info("\n");
-}
-
-void printReport(const pcl_ms::Result &result, double load_ms, double save_ms) {
-  const pcl_ms::StageTimings &timings = result.timings;
-  print_info("\nTimings (ms):\n");
-  printRow("load", "%10.1f", load_ms);
-  printRow("prepare", "%10.1f", timings.prepare * 1e3);
-  printRow("delaunay", "%10.1f", timings.delaunay * 1e3);
-  printRow("scaffold", "%10.1f", timings.scaffold * 1e3);
-  printRow("greedy", "%10.1f", timings.greedy * 1e3);
-  printRow("finish", "%10.1f", timings.finish * 1e3);
-  printRow("total (reconstruction)", "%10.1f", timings.total * 1e3);
-  printRow("save", "%10.1f", save_ms);
-
-  print_info("\nSummary:\n");
-  printRow("input points", "%10.0f", static_cast<double>(result.input_points));
-  printRow("invalid points skipped", "%10.0f", static_cast<double>(result.invalid_points));
-  printRow("duplicates merged", "%10.0f", static_cast<double>(result.duplicate_points));
-  printRow("far points left out", "%10.0f", static_cast<double>(result.far_points));
-  printRow("triangles", "%10.0f", static_cast<double>(result.triangles.size()));
-  printRow("boundary loops", "%10.0f", static_cast<double>(result.boundary_loops.size()));
-  print_info("  %-22s", "components");
-  print_value("%10zu", result.numberOfComponents());
-  print_info(" (");
-  print_value("%zu", result.numberOfNonOrientableComponents());
-  print_info(" non-orientable)\n");
-  printRow("d_med", "%10.6g", result.d_med);
-  printRow("d_max", "%10.6g", result.d_max);
-  if (result.planar)
-    print_info("  (all points lie on one plane: a 2-D Delaunay triangulation was used)\n");
-  const pcl_ms::BucketStatistics &buckets = result.bucket_statistics;
-  if (buckets.buckets > 0) {
-    printRow("buckets", "%10.0f", static_cast<double>(buckets.buckets));
-    printRow("margin points", "%10.0f", static_cast<double>(buckets.margin_points));
-    printRow("seam zones", "%10.0f", static_cast<double>(buckets.seam_zones));
-    printRow("seam points", "%10.0f", static_cast<double>(buckets.seam_points));
-    printRow("seam triangles", "%10.0f", static_cast<double>(buckets.seam_triangles));
-    printRow("buckets (wall ms)", "%10.1f", buckets.buckets_seconds * 1e3);
-    printRow("seams (wall ms)", "%10.1f", buckets.seams_seconds * 1e3);
-    if (buckets.failed_units > 0)
-      printRow("units left empty", "%10.0f", static_cast<double>(buckets.failed_units));
-  }
-}
-
-/// Buckets and seams done, elapsed time and a linear estimate of the rest:
-/// rewritten in place on a terminal, else one line a second.
-class ProgressLine {
-public:
-  void operator()(std::size_t done, std::size_t total) {
-    const auto now = std::chrono::steady_clock::now();
-    if (!terminal_ && done != total && now - last_line_ < std::chrono::seconds(1))
-      return;
-    last_line_ = now;
-    if (first_) // the progress starts below the "Reconstructing" line
-      std::fprintf(stderr, "\n");
-    first_ = false;
-    const double elapsed = std::chrono::duration<double>(now - start_).count();
-    const double left = done > 0 ? elapsed * static_cast<double>(total - done) / done : 0;
-    std::fprintf(stderr, "%s  buckets and seams %zu/%zu, %.1f s elapsed, about %.0f s left%s",
-                 terminal_ ? "\r" : "", done, total, elapsed, left,
-                 terminal_ && done != total ? "   " : "\n");
-    std::fflush(stderr);
-  }
-
-private:
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
-  std::chrono::steady_clock::time_point last_line_ = start_;
-  bool terminal_ = isatty(fileno(stderr)) != 0;
-  bool first_ = true;
-};
-
 int run(int argc, char **argv) {
-  Options options;
+  pcl_ms_tools::ReconstructOptions options;
   std::string error;
-  if (!parseArguments(argc, argv, options, error))
+  if (!pcl_ms_tools::parseReconstructArguments(argc, argv, options, error))
     return fail(kBadArguments, error);
   if (options.help) {
-    printHelp(argv[0]);
+    pcl_ms_tools::printReconstructHelp(
+        argv[0], "Meshes a point cloud by greedy gap transforms on its medial scaffold.");
     return kSuccess;
   }
 
   pcl_ms::Parameters parameters;
-  parameters.rho = options.rho;
-  parameters.fill_holes_max_edges = options.fill_holes;
-  parameters.use_normals = options.normals;
-  parameters.num_threads = options.threads;
-  parameters.bucket_points = options.bucket_points;
-  parameters.grid_buckets = options.grid;
-  if (!options.viewpoint.empty())
-    parameters.viewpoint = {{options.viewpoint[0], options.viewpoint[1], options.viewpoint[2]}};
-  parameters.time_limit_seconds = options.time_limit;
-  if (const std::string reason = parameters.validate(); !reason.empty())
+  if (const std::string reason = pcl_ms_tools::reconstructParameters(options, parameters);
+      !reason.empty())
     return fail(kBadArguments, reason);
-
   // Catch output problems before spending time on the reconstruction.
-  if (!pcl_ms::isMeshOutputSupported(options.output))
-    return fail(kBadArguments, options.output + ": output format '" +
-                                   pcl_ms::fileExtension(options.output) +
-                                   "' is not supported (use .ply, .vtk or .obj)");
-  const std::filesystem::path output_dir = std::filesystem::path(options.output).parent_path();
-  std::error_code code;
-  if (!output_dir.empty() && !std::filesystem::is_directory(output_dir, code))
-    return fail(kIoFailure,
-                options.output + ": directory " + output_dir.string() + " does not exist");
+  if (const int code = pcl_ms_tools::checkMeshOutput(options.output, error); code != kSuccess)
+    return fail(code, error);
 
   const bool verbose = !options.quiet;
-  pcl::console::TicToc timer;
   pcl::PCLPointCloud2 cloud;
-  Eigen::Vector4f sensor_origin;
   double load_ms = 0;
-  if (!fileStep("Loading", options.input, verbose, load_ms, [&] {
-        return pcl_ms::loadPointCloud(options.input, cloud, error, &sensor_origin);
-      }))
-    return fail(kIoFailure, error);
-  if (verbose) {
-    print_info("[done, ");
-    print_value("%.1f", load_ms);
-    print_info(" ms : ");
-    print_value("%u", cloud.width * cloud.height);
-    print_info(" points]\n");
-    print_info("Available dimensions: ");
-    print_value("%s\n", fieldNames(cloud).c_str());
-  }
-  if (!parameters.viewpoint && !options.no_viewpoint)
-    parameters.viewpoint = pcl_ms_tools::sensorViewpoint(cloud, sensor_origin);
-  if (options.normals && !pcl_ms::hasNormals(cloud))
-    return fail(kBadArguments, "-normals was given but " + options.input +
-                                   " has no float normal_x, normal_y, normal_z fields");
+  if (const int code =
+          pcl_ms_tools::loadReconstructInput(options, parameters, cloud, load_ms, error);
+      code != kSuccess)
+    return fail(code, error);
 
-  if (verbose) {
-    print_highlight("Reconstructing with rho ");
-    print_value("%g", options.rho);
-    print_info(", fill holes ");
-    print_value("%d", options.fill_holes);
-    print_info(", normals ");
-    print_value("%s", options.normals ? "on" : "off");
-    print_info(", threads ");
-    print_value("%d", options.threads);
-    if (parameters.viewpoint) {
-      print_info(", viewpoint ");
-      print_value("%g,%g,%g%s", (*parameters.viewpoint)[0], (*parameters.viewpoint)[1],
-                  (*parameters.viewpoint)[2], options.viewpoint.empty() ? " (sensor origin)" : "");
-    }
-    print_info(" ");
-  }
+  if (verbose)
+    pcl_ms_tools::printReconstructStart(options, parameters);
+  pcl::console::TicToc timer;
   timer.tic();
   if (verbose) {
     std::fflush(stdout); // the progress line goes to stderr
-    parameters.progress = ProgressLine();
+    parameters.progress = pcl_ms_tools::ProgressLine();
   }
-  pcl::PolygonMesh mesh;
+  std::vector<pcl::Vertices> polygons;
   pcl_ms::Result result;
   const bool reconstructed =
-      options.normals
-          ? reconstructAs<pcl::PointNormal>(cloud, parameters, mesh.polygons, result, error)
-          : reconstructAs<pcl::PointXYZ>(cloud, parameters, mesh.polygons, result, error);
+      options.normals ? reconstructAs<pcl::PointNormal>(cloud, parameters, polygons, result, error)
+                      : reconstructAs<pcl::PointXYZ>(cloud, parameters, polygons, result, error);
   const double reconstruct_ms = timer.toc();
   if (!reconstructed) {
     if (verbose)
@@ -389,23 +104,17 @@ int run(int argc, char **argv) {
     print_info("[done, ");
     print_value("%.1f", reconstruct_ms);
     print_info(" ms : ");
-    print_value("%zu", mesh.polygons.size());
+    print_value("%zu", polygons.size());
     print_info(" triangles]\n");
   }
 
-  // The output keeps every field of the user's points, not just x, y, z.
-  mesh.header = cloud.header;
-  mesh.cloud = std::move(cloud);
   double save_ms = 0;
-  if (!fileStep("Saving", options.output, verbose, save_ms,
-                [&] { return pcl_ms::saveMesh(options.output, mesh, error); }))
-    return fail(kIoFailure, error);
-  if (verbose) {
-    print_info("[done, ");
-    print_value("%.1f", save_ms);
-    print_info(" ms]\n");
-    printReport(result, load_ms, save_ms);
-  }
+  if (const int code = pcl_ms_tools::saveReconstructedMesh(options, std::move(cloud),
+                                                           std::move(polygons), save_ms, error);
+      code != kSuccess)
+    return fail(code, error);
+  if (verbose)
+    pcl_ms_tools::printReconstructReport(result, load_ms, save_ms);
   return kSuccess;
 }
 

@@ -19,6 +19,10 @@ PACKAGES=(
   libtbb-dev
   libgmp-dev
   libmpfr-dev
+  # pcl_ms_reconstruct_mpi and its tests (mpirun); without them the tool is
+  # not built.
+  openmpi-bin
+  libopenmpi-dev
   # Off-screen pictures (apps/common/render_mesh.cpp): Debian's VTK draws
   # through GLX only, so headless machines get a private Xvfb, and Mesa's
   # software OpenGL (llvmpipe, loaded at run time) does the drawing. libpng

@@ -302,8 +302,9 @@ class BucketedMesher {
 public:
   BucketedMesher(const std::vector<Eigen::Vector3d> &points,
                  const std::vector<Eigen::Vector3f> *normals, const Parameters &parameters,
-                 const Deadline *deadline)
+                 const Deadline *deadline, BucketExchange &exchange)
       : points_(points), normals_(normals), parameters_(parameters), deadline_(deadline),
+        exchange_(exchange),
         tree_(points,
               parameters.bucket_points > 0 ? parameters.bucket_points : default_bucket_points,
               parameters.grid_buckets) {}
@@ -318,7 +319,15 @@ public:
         inner.push_back(static_cast<int>(i));
         max_depth = std::max(max_depth, nodes[i].depth);
       }
-    ProgressReporter progress(parameters_, leaves.size() + inner.size());
+    // This process's units: its leaves, and the zones whose first leaf it owns.
+    std::vector<std::size_t> own_leaves;
+    for (std::size_t i = 0; i < leaves.size(); ++i)
+      if (owner(static_cast<std::uint32_t>(i)) == exchange_.process())
+        own_leaves.push_back(i);
+    std::size_t own_zones = 0;
+    for (int index : inner)
+      own_zones += owner(nodes[index].first_leaf) == exchange_.process();
+    ProgressReporter progress(parameters_, own_leaves.size() + own_zones);
     surface_.statistics.buckets = leaves.size();
     surface_.statistics.seam_zones = inner.size();
 
@@ -337,39 +346,65 @@ public:
     std::vector<BucketOutcome> leaf_outcomes(leaves.size());
     std::vector<std::size_t> margin_points(leaves.size(), 0);
     arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size(), 1),
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, own_leaves.size(), 1),
                         [&](const tbb::blocked_range<std::size_t> &range) {
-                          for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                          for (std::size_t k = range.begin(); k != range.end(); ++k) {
+                            const std::size_t i = own_leaves[k];
                             margin_points[i] = meshLeaf(nodes[leaves[i]], leaf_outcomes[i]);
                             progress.unitDone();
                           }
                         });
     });
-    for (std::size_t count : margin_points)
-      surface_.statistics.margin_points += count;
-    std::vector<double> bucket_d_meds;
-    for (const BucketOutcome &outcome : leaf_outcomes) {
+    // Per leaf: d_med, failed, margin points; only the owner's are non-zero.
+    std::vector<double> leaf_figures(3 * leaves.size(), 0.0);
+    std::string first_error;
+    for (std::size_t i : own_leaves) {
+      const BucketOutcome &outcome = leaf_outcomes[i];
       addTimings(outcome);
-      if (outcome.error.empty())
-        bucket_d_meds.push_back(outcome.d_med);
+      leaf_figures[3 * i] = outcome.error.empty() ? outcome.d_med : 0.0;
+      leaf_figures[3 * i + 1] = outcome.error.empty() ? 0.0 : 1.0;
+      leaf_figures[3 * i + 2] = static_cast<double>(margin_points[i]);
+      if (first_error.empty())
+        first_error = outcome.error;
+    }
+    exchange_.sumOver(leaf_figures);
+    // Seams read the scales of points that other processes' buckets own.
+    exchange_.maxOver(surface_.local_scale);
+    std::vector<double> bucket_d_meds;
+    for (std::size_t i = 0; i < leaves.size(); ++i) {
+      surface_.statistics.margin_points += static_cast<std::size_t>(leaf_figures[3 * i + 2]);
+      if (leaf_figures[3 * i + 1] == 0.0)
+        bucket_d_meds.push_back(leaf_figures[3 * i]);
       else
         ++surface_.statistics.failed_units;
     }
     if (bucket_d_meds.empty())
-      throw ReconstructionError("no bucket could be meshed: " + leaf_outcomes.front().error);
+      throw ReconstructionError("no bucket could be meshed" +
+                                (first_error.empty() ? std::string() : ": " + first_error));
     std::nth_element(bucket_d_meds.begin(), bucket_d_meds.begin() + bucket_d_meds.size() / 2,
                      bucket_d_meds.end());
     surface_.d_med = bucket_d_meds[bucket_d_meds.size() / 2];
     surface_.statistics.buckets_seconds = secondsSince(stage);
+    exchange_.stageDone("buckets");
 
     // Seams bottom-up: a zone's subtrees are complete when it is stitched,
     // and zones of one depth are disjoint, so they run in parallel.
     stage = Clock::now();
+    std::vector<double> seam_figures(3, 0.0); // points, triangles, failed units
     for (int depth = max_depth; depth >= 0; --depth) {
       std::vector<int> level;
-      for (int index : inner)
-        if (nodes[index].depth == depth)
+      std::vector<BucketExchange::Transfer> transfers;
+      for (int index : inner) {
+        if (nodes[index].depth != depth)
+          continue;
+        const int zone_owner = owner(nodes[index].first_leaf);
+        for (int child : nodes[index].children)
+          if (const int child_owner = owner(nodes[child].first_leaf); child_owner != zone_owner)
+            transfers.push_back({child_owner, zone_owner, &nodes[child].triangles});
+        if (zone_owner == exchange_.process())
           level.push_back(index);
+      }
+      exchange_.moveTriangles(transfers);
       std::vector<BucketOutcome> outcomes(level.size());
       std::vector<std::size_t> zone_points(level.size(), 0);
       arena.execute([&] {
@@ -383,12 +418,24 @@ public:
       });
       for (std::size_t i = 0; i < level.size(); ++i) {
         addTimings(outcomes[i]);
-        surface_.statistics.seam_points += zone_points[i];
-        surface_.statistics.seam_triangles += outcomes[i].triangles.size();
+        seam_figures[0] += static_cast<double>(zone_points[i]);
+        seam_figures[1] += static_cast<double>(outcomes[i].triangles.size());
         if (!outcomes[i].error.empty() && zone_points[i] >= 3)
-          ++surface_.statistics.failed_units;
+          seam_figures[2] += 1;
       }
+      exchange_.stageDone("seam level " + std::to_string(depth));
     }
+    std::vector<double> timings = {surface_.delaunay_seconds, surface_.scaffold_seconds,
+                                   surface_.greedy_seconds};
+    exchange_.sumOver(seam_figures);
+    exchange_.sumOver(timings);
+    surface_.statistics.seam_points = static_cast<std::size_t>(seam_figures[0]);
+    surface_.statistics.seam_triangles = static_cast<std::size_t>(seam_figures[1]);
+    surface_.statistics.failed_units += static_cast<std::size_t>(seam_figures[2]);
+    surface_.delaunay_seconds = timings[0];
+    surface_.scaffold_seconds = timings[1];
+    surface_.greedy_seconds = timings[2];
+    exchange_.maxOver(may_pinch_);
     surface_.triangles = std::move(nodes[tree_.root()].triangles);
     // Points of buckets that could not be meshed take the typical scale.
     for (float &scale : surface_.local_scale)
@@ -397,11 +444,13 @@ public:
     // Kept triangles may pinch where their neighbours were cut away, and a
     // seam may fail to join two fixed fans at a vertex: bow-ties are possible
     // only at those vertices.
-    std::vector<bool> may_pinch(points_.size(), false);
-    for (std::size_t v = 0; v < points_.size(); ++v)
-      may_pinch[v] = may_pinch_[v] != 0;
-    surface_.statistics.bow_tie_triangles_removed =
-        splitBowTies(surface_.triangles, points_.size(), may_pinch);
+    if (exchange_.process() == 0) {
+      std::vector<bool> may_pinch(points_.size(), false);
+      for (std::size_t v = 0; v < points_.size(); ++v)
+        may_pinch[v] = may_pinch_[v] != 0;
+      surface_.statistics.bow_tie_triangles_removed =
+          splitBowTies(surface_.triangles, points_.size(), may_pinch);
+    }
     surface_.statistics.seams_seconds = secondsSince(stage);
     return std::move(surface_);
   }
@@ -549,6 +598,10 @@ private:
 
   std::vector<Node> &nodes_() { return tree_.nodes(); }
 
+  int owner(std::uint32_t leaf) const {
+    return bucketOwner(leaf, tree_.leaves().size(), exchange_.processes());
+  }
+
   /// Units write disjoint points (their core), so bytes, not bits.
   void markMayPinch(const std::vector<VertexIndex> &local,
                     const std::vector<VertexIndex> &members) {
@@ -566,6 +619,7 @@ private:
   const std::vector<Eigen::Vector3f> *normals_;
   const Parameters &parameters_;
   const Deadline *deadline_;
+  BucketExchange &exchange_;
   BucketTree tree_;
   std::vector<double> leaf_margin_; // by leaf number
   BucketedSurface surface_;
@@ -639,8 +693,11 @@ bool usesBuckets(std::size_t points, const Parameters &parameters) {
 
 BucketedSurface meshInBuckets(const std::vector<Eigen::Vector3d> &points,
                               const std::vector<Eigen::Vector3f> *normals,
-                              const Parameters &parameters, const Deadline *deadline) {
-  return BucketedMesher(points, normals, parameters, deadline).run();
+                              const Parameters &parameters, const Deadline *deadline,
+                              BucketExchange *exchange) {
+  BucketExchange one_process;
+  return BucketedMesher(points, normals, parameters, deadline, exchange ? *exchange : one_process)
+      .run();
 }
 
 } // namespace pcl_ms

@@ -266,6 +266,9 @@ std::vector<Triangle> prepareInitialTriangles(const std::vector<Triangle> &initi
   return mapped;
 }
 
+Result reconstructShared(const PointView &points, const Parameters &parameters,
+                         const std::vector<Triangle> &initial_triangles, BucketExchange &exchange);
+
 } // namespace
 
 Result reconstruct(const PointView &points, const Parameters &parameters) {
@@ -273,7 +276,20 @@ Result reconstruct(const PointView &points, const Parameters &parameters) {
 }
 
 Result reconstruct(const PointView &points, const Parameters &parameters,
+                   BucketExchange &exchange) {
+  return reconstructShared(points, parameters, {}, exchange);
+}
+
+Result reconstruct(const PointView &points, const Parameters &parameters,
                    const std::vector<Triangle> &initial_triangles) {
+  BucketExchange one_process;
+  return reconstructShared(points, parameters, initial_triangles, one_process);
+}
+
+namespace {
+
+Result reconstructShared(const PointView &points, const Parameters &parameters,
+                         const std::vector<Triangle> &initial_triangles, BucketExchange &exchange) {
   const Clock::time_point start = Clock::now();
   const std::string invalid = parameters.validate();
   if (!invalid.empty())
@@ -296,9 +312,15 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
   std::vector<Triangle> triangles;
   std::vector<float> local_scale; // per distinct point
   // Initial triangles are honoured by the one-piece path only.
-  if (fixed.empty() && usesBuckets(prepared.positions.size(), parameters)) {
+  const bool in_buckets = fixed.empty() && usesBuckets(prepared.positions.size(), parameters);
+  // Only process 0 meshes a one-piece cloud and finishes the surface.
+  const bool gathers = exchange.process() == 0;
+  if (!in_buckets && !gathers)
+    return result;
+  if (in_buckets) {
     deadline.check("the preparation");
-    BucketedSurface bucketed = meshInBuckets(prepared.positions, normals, parameters, &deadline);
+    BucketedSurface bucketed =
+        meshInBuckets(prepared.positions, normals, parameters, &deadline, &exchange);
     triangles = std::move(bucketed.triangles);
     local_scale = std::move(bucketed.local_scale);
     result.d_med = bucketed.d_med;
@@ -309,6 +331,10 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
     result.timings.greedy = bucketed.greedy_seconds;
     result.peak_memory.scaffold = result.peak_memory.greedy =
         std::max(result.peak_memory.prepare, peakResidentBytes());
+    if (!gathers) {
+      result.timings.total = secondsSince(start);
+      return result;
+    }
   } else {
     stage = Clock::now();
     ScaffoldOptions options;
@@ -385,5 +411,7 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
   result.timings.total = secondsSince(start);
   return result;
 }
+
+} // namespace
 
 } // namespace pcl_ms

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -78,10 +79,45 @@ struct BucketedSurface {
   double delaunay_seconds = 0, scaffold_seconds = 0, greedy_seconds = 0;
 };
 
+/// Shares the buckets and seam zones of meshInBuckets among cooperating
+/// processes that all hold the same points (docs/algorithm.md, "Across
+/// processes"). The default is one process doing everything. Process r owns
+/// a contiguous range of leaves (bucketOwner) and every zone whose first
+/// leaf it owns, so process 0 owns the root and ends up with the whole
+/// surface. Every call is collective: all processes make it, in the same
+/// order.
+class BucketExchange {
+public:
+  virtual ~BucketExchange() = default;
+  virtual int processes() const { return 1; }
+  virtual int process() const { return 0; }
+  /// Element-wise maximum (scales: owners have them, the others 0).
+  virtual void maxOver(std::vector<float> &) {}
+  virtual void maxOver(std::vector<std::uint8_t> &) {}
+  /// Element-wise sum (per-unit figures: only the owner's is non-zero).
+  virtual void sumOver(std::vector<double> &) {}
+  struct Transfer {
+    int from = 0, to = 0;
+    std::vector<Triangle> *triangles = nullptr; // sent from `from`, then emptied there
+  };
+  /// Moves each transfer's triangles from its sender to its receiver.
+  virtual void moveTriangles(const std::vector<Transfer> &) {}
+  /// Called on every process after the buckets and after each seam level.
+  virtual void stageDone(const std::string & /*stage*/) {}
+};
+
+/// The process that meshes leaf number `leaf` of `leaves`.
+inline int bucketOwner(std::size_t leaf, std::size_t leaves, int processes) {
+  return static_cast<int>(leaf * static_cast<std::size_t>(processes) / leaves);
+}
+
 /// Meshes the points in buckets and stitches them. `normals` is null or has
-/// one entry per point. The result does not depend on the thread count.
+/// one entry per point. The result does not depend on the thread count, nor
+/// on how `exchange` shares the work; with several processes only process 0
+/// gets the triangles (the others' are empty).
 BucketedSurface meshInBuckets(const std::vector<Eigen::Vector3d> &points,
                               const std::vector<Eigen::Vector3f> *normals,
-                              const Parameters &parameters, const Deadline *deadline = nullptr);
+                              const Parameters &parameters, const Deadline *deadline = nullptr,
+                              BucketExchange *exchange = nullptr);
 
 } // namespace pcl_ms

@@ -32,4 +32,14 @@ Result reconstruct(const PointView &points, const Parameters &parameters);
 Result reconstruct(const PointView &points, const Parameters &parameters,
                    const std::vector<Triangle> &initial_triangles);
 
+class BucketExchange;
+
+/// Meshes the points with several processes sharing the buckets and seam
+/// zones (see BucketExchange in buckets.h). Every process calls it with the
+/// same points and parameters; the triangles are the same as with one.
+/// Process 0 gets the mesh; the others get the preparation's and the
+/// buckets' figures and no triangles. A cloud meshed in one piece is meshed
+/// by process 0 alone.
+Result reconstruct(const PointView &points, const Parameters &parameters, BucketExchange &exchange);
+
 } // namespace pcl_ms

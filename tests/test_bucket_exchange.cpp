@@ -1,0 +1,157 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// pcl_ms::BucketExchange without MPI: threads stand in for processes, so
+// the sharing of buckets and seams (docs/algorithm.md, "Across processes")
+// is checked in every build, sanitizers included.
+#include "test_support.h"
+
+#include <pcl_ms/buckets.h>
+#include <pcl_ms/reconstruct.h>
+
+#include <algorithm>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
+namespace {
+
+using namespace pcl_ms_test;
+
+/// What the "processes" share: a barrier and one posted pointer each.
+class Hub {
+public:
+  explicit Hub(int processes) : processes_(processes), posted_(processes, nullptr) {}
+
+  void wait() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    const std::size_t generation = generation_;
+    if (++waiting_ == processes_) {
+      waiting_ = 0;
+      ++generation_;
+      changed_.notify_all();
+    } else {
+      changed_.wait(lock, [&] { return generation_ != generation; });
+    }
+  }
+  int processes() const { return processes_; }
+  std::vector<void *> &posted() { return posted_; }
+
+private:
+  const int processes_;
+  std::vector<void *> posted_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  int waiting_ = 0;
+  std::size_t generation_ = 0;
+};
+
+class ThreadExchange : public pcl_ms::BucketExchange {
+public:
+  ThreadExchange(Hub &hub, int process) : hub_(hub), process_(process) {}
+  int processes() const override { return hub_.processes(); }
+  int process() const override { return process_; }
+  void maxOver(std::vector<float> &values) override {
+    combine(values, [](float a, float b) { return std::max(a, b); });
+  }
+  void maxOver(std::vector<std::uint8_t> &values) override {
+    combine(values, [](std::uint8_t a, std::uint8_t b) { return std::max(a, b); });
+  }
+  void sumOver(std::vector<double> &values) override {
+    combine(values, [](double a, double b) { return a + b; });
+  }
+  void moveTriangles(const std::vector<Transfer> &transfers) override {
+    for (const Transfer &transfer : transfers) {
+      if (transfer.from == process_)
+        hub_.posted()[process_] = transfer.triangles;
+      hub_.wait();
+      if (transfer.to == process_)
+        *transfer.triangles =
+            std::move(*static_cast<std::vector<pcl_ms::Triangle> *>(hub_.posted()[transfer.from]));
+      hub_.wait();
+    }
+  }
+  void stageDone(const std::string &) override { ++stages; }
+
+  int stages = 0;
+
+private:
+  /// Every process reads all values, then (after everyone has read) writes its own.
+  template <typename Value, typename Operation>
+  void combine(std::vector<Value> &values, Operation operation) {
+    hub_.posted()[process_] = &values;
+    hub_.wait();
+    std::vector<Value> combined = values;
+    for (int other = 0; other < hub_.processes(); ++other) {
+      const auto &theirs = *static_cast<std::vector<Value> *>(hub_.posted()[other]);
+      if (theirs.size() != values.size()) { // not ASSERT: the others wait at the barrier
+        ADD_FAILURE() << "process " << other << " has " << theirs.size() << " values";
+        continue;
+      }
+      if (other != process_)
+        for (std::size_t i = 0; i < values.size(); ++i)
+          combined[i] = operation(combined[i], theirs[i]);
+    }
+    hub_.wait();
+    values = std::move(combined);
+  }
+
+  Hub &hub_;
+  int process_;
+};
+
+TEST(BucketExchange, ProcessesGiveTheOneProcessMesh) {
+  const auto cloud = loadXYZ("bunny.pcd");
+  pcl_ms::Parameters parameters;
+  parameters.bucket_points = 4000;
+  const pcl_ms::Result reference = pcl_ms::reconstruct(viewOf(*cloud), parameters);
+  const pcl_ms::BucketStatistics &expected = reference.bucket_statistics;
+  ASSERT_GE(expected.buckets, 8u);
+  ASSERT_GT(expected.seam_triangles, 0u);
+
+  // 3 does not divide the buckets evenly; 24 leaves some processes without a leaf.
+  for (int processes : {2, 3, 24}) {
+    Hub hub(processes);
+    std::vector<pcl_ms::Result> results(processes);
+    std::vector<ThreadExchange> exchanges;
+    for (int p = 0; p < processes; ++p)
+      exchanges.emplace_back(hub, p);
+    std::vector<std::thread> threads;
+    for (int p = 0; p < processes; ++p)
+      threads.emplace_back(
+          [&, p] { results[p] = pcl_ms::reconstruct(viewOf(*cloud), parameters, exchanges[p]); });
+    for (std::thread &thread : threads)
+      thread.join();
+
+    EXPECT_EQ(results[0].triangles, reference.triangles) << processes << " processes";
+    EXPECT_EQ(results[0].boundary_loops, reference.boundary_loops) << processes << " processes";
+    EXPECT_EQ(results[0].d_med, reference.d_med);
+    for (int p = 0; p < processes; ++p) {
+      const pcl_ms::BucketStatistics &got = results[p].bucket_statistics;
+      EXPECT_EQ(got.buckets, expected.buckets);
+      EXPECT_EQ(got.seam_zones, expected.seam_zones);
+      EXPECT_EQ(got.margin_points, expected.margin_points) << "process " << p;
+      EXPECT_EQ(got.seam_points, expected.seam_points) << "process " << p;
+      EXPECT_EQ(got.seam_triangles, expected.seam_triangles) << "process " << p;
+      EXPECT_EQ(got.failed_units, 0u);
+      if (p > 0) {
+        EXPECT_TRUE(results[p].triangles.empty()) << "process " << p;
+      }
+      // The buckets, then one stage per seam level.
+      EXPECT_EQ(exchanges[p].stages, exchanges[0].stages);
+    }
+    EXPECT_GE(exchanges[0].stages, 4);
+  }
+}
+
+TEST(BucketExchange, LeavesAreSharedInContiguousRanges) {
+  // 10 leaves on 4 processes: 3, 2, 3, 2 (rounded down multiples).
+  std::vector<int> owners;
+  for (std::size_t leaf = 0; leaf < 10; ++leaf)
+    owners.push_back(pcl_ms::bucketOwner(leaf, 10, 4));
+  EXPECT_EQ(owners, (std::vector<int>{0, 0, 0, 1, 1, 2, 2, 2, 3, 3}));
+  // More processes than leaves: each leaf its own process, some idle.
+  EXPECT_EQ(pcl_ms::bucketOwner(0, 3, 8), 0);
+  EXPECT_EQ(pcl_ms::bucketOwner(1, 3, 8), 2);
+  EXPECT_EQ(pcl_ms::bucketOwner(2, 3, 8), 5);
+}
+
+} // namespace
