@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <random>
 #include <set>
@@ -269,6 +270,53 @@ TEST(PclClass, IndicesAreRespected) {
     for (auto v : polygon.vertices)
       EXPECT_GE(v, 200u);
   EXPECT_EQ(reconstruction.getResult().boundary_loops.size(), 0u);
+}
+
+TEST(PclClass, BoundaryLoopsRunAlongTheMeshRimsInUserIndices) {
+  // The bunny after 100 points that setIndices leaves out: loops must name
+  // the user's records, as the polygons do.
+  const auto bunny = loadXYZ("bunny.pcd");
+  auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  const std::vector<float> far = fibonacciSphere(100, 0.01, {1, 1, 1});
+  for (std::size_t i = 0; i < 100; ++i)
+    cloud->push_back(pcl::PointXYZ(far[3 * i], far[3 * i + 1], far[3 * i + 2]));
+  *cloud += *bunny;
+  auto bunny_records = std::make_shared<pcl::Indices>(bunny->size());
+  std::iota(bunny_records->begin(), bunny_records->end(), 100);
+  pcl::MedialScaffoldReconstruction<pcl::PointXYZ> reconstruction;
+  reconstruction.setInputCloud(cloud);
+  reconstruction.setIndices(bunny_records);
+  pcl::PolygonMesh mesh;
+  reconstruction.reconstruct(mesh);
+  ASSERT_EQ(reconstruction.getErrorMessage(), "");
+
+  // Edges used by one polygon only, as (low, high) record pairs.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+  for (const pcl::Vertices &polygon : mesh.polygons)
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t a = polygon.vertices[k], b = polygon.vertices[(k + 1) % 3];
+      ++uses[{std::min(a, b), std::max(a, b)}];
+    }
+  std::set<std::pair<std::uint32_t, std::uint32_t>> rim;
+  for (const auto &[edge, count] : uses)
+    if (count == 1)
+      rim.insert(edge);
+
+  const std::vector<pcl::Vertices> loops = reconstruction.getBoundaryLoops();
+  EXPECT_EQ(loops.size(), 5u); // the holes in the base
+  std::set<std::pair<std::uint32_t, std::uint32_t>> on_loops;
+  for (const pcl::Vertices &loop : loops) {
+    ASSERT_GE(loop.vertices.size(), 3u);
+    for (std::size_t k = 0; k < loop.vertices.size(); ++k) {
+      const std::uint32_t a = loop.vertices[k];
+      const std::uint32_t b = loop.vertices[(k + 1) % loop.vertices.size()];
+      EXPECT_GE(a, 100u);
+      EXPECT_TRUE(rim.count({std::min(a, b), std::max(a, b)}))
+          << "loop edge " << a << "-" << b << " is not on the mesh's rim";
+      on_loops.insert({std::min(a, b), std::max(a, b)});
+    }
+  }
+  EXPECT_EQ(on_loops, rim); // every rim edge is on a loop
 }
 
 TEST(PclClass, NormalsFromThePointTypeOrASeparateCloud) {
