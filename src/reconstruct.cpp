@@ -406,6 +406,7 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
   result.triangle_component = std::move(surface.triangle_component);
   result.component_orientable = std::move(surface.component_orientable);
   result.holes_filled = surface.holes_filled;
+  result.twist_triangles_removed = surface.twist_triangles_removed;
   result.timings.finish = secondsSince(stage);
   result.peak_memory.finish = std::max(result.peak_memory.greedy, peakResidentBytes());
   result.timings.total = secondsSince(start);

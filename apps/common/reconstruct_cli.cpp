@@ -284,6 +284,8 @@ void printReconstructReport(const pcl_ms::Result &result, double load_ms, double
   printRow("far points left out", "%10.0f", static_cast<double>(result.far_points));
   printRow("triangles", "%10.0f", static_cast<double>(result.triangles.size()));
   printRow("boundary loops", "%10.0f", static_cast<double>(result.boundary_loops.size()));
+  printRow("holes filled", "%10.0f", static_cast<double>(result.holes_filled));
+  printRow("fold triangles cut", "%10.0f", static_cast<double>(result.twist_triangles_removed));
   print_info("  %-22s", "components");
   print_value("%10zu", result.numberOfComponents());
   print_info(" (");

@@ -154,6 +154,9 @@ struct Result {
   std::size_t cleanup_undone = 0; // flaps/isolated triangles and final sweep
   std::size_t swapped_pairs = 0;  // non-Delaunay quads re-triangulated
   std::size_t holes_filled = 0;
+  /// Triangles cut out where the surface folded or twisted (the finish's
+  /// twist repair; docs/algorithm.md, "Finishing").
+  std::size_t twist_triangles_removed = 0;
   BucketStatistics bucket_statistics;
   StageTimings timings;
   StagePeakMemory peak_memory;
