@@ -749,6 +749,30 @@ bool loadPlyCloud(const std::string &path, std::uintmax_t size, pcl::PCLPointClo
   return true;
 }
 
+/// A cloud of FLOAT32 columns (x y z [normal_x normal_y normal_z]) from
+/// `values`, `columns` per point.
+void makeFloatCloud(const std::vector<float> &values, std::size_t columns,
+                    pcl::PCLPointCloud2 &cloud) {
+  const char *names[] = {"x", "y", "z", "normal_x", "normal_y", "normal_z"};
+  cloud = pcl::PCLPointCloud2();
+  for (std::size_t c = 0; c < columns; ++c) {
+    pcl::PCLPointField field;
+    field.name = names[c];
+    field.offset = static_cast<std::uint32_t>(c * sizeof(float));
+    field.datatype = pcl::PCLPointField::FLOAT32;
+    field.count = 1;
+    cloud.fields.push_back(field);
+  }
+  cloud.point_step = static_cast<std::uint32_t>(columns * sizeof(float));
+  cloud.width = static_cast<std::uint32_t>(values.size() / columns);
+  cloud.height = 1;
+  cloud.row_step = cloud.point_step * cloud.width;
+  cloud.is_dense =
+      std::all_of(values.begin(), values.end(), [](float v) { return std::isfinite(v); });
+  cloud.data.resize(values.size() * sizeof(float));
+  std::memcpy(cloud.data.data(), values.data(), cloud.data.size());
+}
+
 bool loadXyzCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::string &error) {
   std::string bytes;
   if (!readFileBytes(path, bytes, error))
@@ -800,25 +824,7 @@ bool loadXyzCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::stri
     error = "the file contains no points";
     return false;
   }
-
-  const char *names[] = {"x", "y", "z", "normal_x", "normal_y", "normal_z"};
-  cloud = pcl::PCLPointCloud2();
-  for (std::size_t c = 0; c < columns; ++c) {
-    pcl::PCLPointField field;
-    field.name = names[c];
-    field.offset = static_cast<std::uint32_t>(c * sizeof(float));
-    field.datatype = pcl::PCLPointField::FLOAT32;
-    field.count = 1;
-    cloud.fields.push_back(field);
-  }
-  cloud.point_step = static_cast<std::uint32_t>(columns * sizeof(float));
-  cloud.width = static_cast<std::uint32_t>(values.size() / columns);
-  cloud.height = 1;
-  cloud.row_step = cloud.point_step * cloud.width;
-  cloud.is_dense =
-      std::all_of(values.begin(), values.end(), [](float v) { return std::isfinite(v); });
-  cloud.data.resize(values.size() * sizeof(float));
-  std::memcpy(cloud.data.data(), values.data(), cloud.data.size());
+  makeFloatCloud(values, columns, cloud);
   return true;
 }
 
@@ -1482,6 +1488,41 @@ bool hasNormals(const pcl::PCLPointCloud2 &cloud) {
          isSingleFloatField(findField(cloud, "normal_z"));
 }
 
+namespace {
+
+/// The vertices of an .obj, .off or .vtk mesh as a cloud, in file order;
+/// faces may be absent (a vertex-only OFF is a point cloud).
+bool loadMeshVerticesCloud(const std::string &path, pcl::PCLPointCloud2 &cloud,
+                           std::string &reason) {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<Triangle> triangles;
+  const std::string extension = fileExtension(path);
+  const bool ok = extension == ".obj"   ? loadObjMesh(path, vertices, triangles, reason)
+                  : extension == ".off" ? loadOffMesh(path, vertices, triangles, reason)
+                                        : loadVtkMesh(path, vertices, triangles, reason);
+  if (!ok)
+    return false;
+  if (vertices.empty()) {
+    reason = "the file contains no vertices";
+    return false;
+  }
+  std::vector<float> values;
+  values.reserve(3 * vertices.size());
+  for (std::size_t i = 0; i < vertices.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const double value = vertices[i][k];
+      if (std::isfinite(value) && std::abs(value) > std::numeric_limits<float>::max()) {
+        reason = "vertex " + std::to_string(i) + " is out of float range";
+        return false;
+      }
+      values.push_back(static_cast<float>(value));
+    }
+  makeFloatCloud(values, 3, cloud);
+  return true;
+}
+
+} // namespace
+
 bool loadPointCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::string &error,
                     Eigen::Vector4f *sensor_origin) {
   cloud = pcl::PCLPointCloud2();
@@ -1493,15 +1534,17 @@ bool loadPointCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::st
     std::uintmax_t size = 0;
     if (!checkInputFile(path, size, reason))
       ok = false;
-    else if (extension != ".pcd" && extension != ".ply" && extension != ".xyz" &&
-             extension != ".txt")
-      reason = unknownFormat(extension, "point cloud", ".pcd, .ply, .xyz or .txt");
     else if (extension == ".pcd")
       ok = loadPcdCloud(path, size, cloud, origin, reason);
     else if (extension == ".ply")
       ok = loadPlyCloud(path, size, cloud, reason);
-    else
+    else if (extension == ".xyz" || extension == ".txt")
       ok = loadXyzCloud(path, cloud, reason);
+    else if (extension == ".obj" || extension == ".off" || extension == ".vtk")
+      ok = loadMeshVerticesCloud(path, cloud, reason);
+    else
+      reason = unknownFormat(extension, "point cloud",
+                             ".pcd, .ply, .xyz, .txt, or a mesh's vertices: .obj, .off, .vtk");
     ok = ok && checkCloudLayout(cloud, reason);
   } catch (const std::exception &exception) {
     reason = std::string("unexpected failure: ") + exception.what();

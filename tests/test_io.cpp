@@ -3,6 +3,7 @@
 // (suite App). Every file they write goes to a fresh temporary directory.
 #include "program_test.h"
 #include "synthetic_clouds.h"
+#include "test_support.h"
 
 #include <pcl_ms/io.h>
 
@@ -17,6 +18,7 @@
 #include <cstring>
 #include <filesystem>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -397,6 +399,45 @@ TEST_F(IoLoadPointCloud, NonexistentFileFails) {
 TEST_F(IoLoadPointCloud, DirectoryFails) {
   fs::create_directory(path("folder.pcd"));
   EXPECT_TRUE(contains(expectCloudFailure(path("folder.pcd")), "directory"));
+}
+
+TEST_F(IoLoadPointCloud, MeshVerticesInFileOrderWithOrWithoutFaces) {
+  // The bunny's vertices through a mesh file with faces (OBJ), one without
+  // (a vertex-only OFF) and legacy VTK: the same floats as bunny.pcd.
+  const pcl_ms_test::ReferenceMesh &bunny = pcl_ms_test::bunnyReference();
+  std::ostringstream obj, off, vtk;
+  for (std::ostringstream *out : {&obj, &off, &vtk})
+    out->precision(9); // enough to give back each float exactly
+  off << "OFF\n" << bunny.vertices.size() << " 0 0\n";
+  vtk << "# vtk DataFile Version 3.0\nbunny\nASCII\nDATASET POLYDATA\nPOINTS "
+      << bunny.vertices.size() << " float\n";
+  for (const Eigen::Vector3d &v : bunny.vertices) {
+    obj << "v " << v.x() << " " << v.y() << " " << v.z() << "\n";
+    off << v.x() << " " << v.y() << " " << v.z() << "\n";
+    vtk << v.x() << " " << v.y() << " " << v.z() << "\n";
+  }
+  vtk << "POLYGONS " << bunny.triangles.size() << " " << 4 * bunny.triangles.size() << "\n";
+  for (const pcl_ms::Triangle &t : bunny.triangles) {
+    obj << "f " << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << "\n";
+    vtk << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
+  }
+  writeFile(path("bunny.obj"), obj.str());
+  writeFile(path("bunny.off"), off.str());
+  writeFile(path("bunny.vtk"), vtk.str());
+  const auto expected = pcl_ms_test::loadXYZ("bunny.pcd");
+  for (const char *name : {"bunny.obj", "bunny.off", "bunny.vtk"}) {
+    SCOPED_TRACE(name);
+    pcl::PCLPointCloud2 loaded;
+    std::string error;
+    ASSERT_TRUE(pcl_ms::loadPointCloud(path(name), loaded, error)) << error;
+    pcl::PointCloud<pcl::PointXYZ> points;
+    pcl::fromPCLPointCloud2(loaded, points);
+    ASSERT_EQ(points.size(), expected->size());
+    for (std::size_t i = 0; i < points.size(); ++i)
+      ASSERT_TRUE(points[i].getVector3fMap() == (*expected)[i].getVector3fMap()) << "point " << i;
+  }
+  writeFile(path("empty.off"), "OFF\n0 0 0\n");
+  EXPECT_TRUE(contains(expectCloudFailure(path("empty.off")), "no vertices"));
 }
 
 TEST_F(IoLoadPointCloud, UnknownExtensionFails) {

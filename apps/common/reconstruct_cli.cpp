@@ -58,7 +58,8 @@ std::string fieldNames(const pcl::PCLPointCloud2 &cloud) {
 void printReconstructHelp(const char *program, const char *summary) {
   print_info("%s\n\n", summary);
   print_info("Usage: %s input output [options]\n\n", program);
-  print_info("  input   point cloud: .pcd, .ply, .xyz or .txt (x y z [nx ny nz] per line)\n");
+  print_info("  input   point cloud: .pcd, .ply, .xyz or .txt (x y z [nx ny nz] per line), or\n"
+             "          the vertices of a mesh: .obj, .off or .vtk\n");
   print_info("  output  mesh: .ply (binary), .vtk or .obj; its vertices are the input points, in\n"
              "          order, with colours and normals where the format can hold them\n\n");
   print_info("Options:\n");

@@ -25,7 +25,9 @@ std::string fileExtension(const std::string &path);
 ///  - .ply: a point cloud or the vertices of a mesh (PCL's reader); range
 ///    scans with a `range_grid` element yield their vertices only, unorganized;
 ///  - .xyz / .txt: whitespace-separated columns, 3 (x y z) or 6 (x y z nx ny
-///    nz) per line; blank lines and `#` comments are skipped.
+///    nz) per line; blank lines and `#` comments are skipped;
+///  - .obj, .off, .vtk (legacy POLYDATA): the vertices of a mesh, in file
+///    order, as x y z (faces, if any, are read and dropped).
 /// On success `cloud` has FLOAT32 fields x, y, z (plus whatever else the file
 /// holds) and at least one point. On failure `cloud` is left empty.
 /// `sensor_origin`, when given, receives a PCD file's VIEWPOINT position
