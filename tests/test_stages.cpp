@@ -505,6 +505,34 @@ TEST(Finish, TwistIsCutWhereTheBandFoldsOverItself) {
   EXPECT_EQ(inconsistent_edges, 1u);
 }
 
+TEST(Finish, FoldsLoseOnlyTheTrianglesAtTheInconsistentEdge) {
+  // A flat annulus of quads with one quad crossed over itself: a sharp fold
+  // that no orientation can get through. Cutting it must not cost more than
+  // that quad's triangles (cutting the worst corner's fan, as before, took 3).
+  const int segments = 40;
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < segments; ++i) {
+    const double angle = 2 * M_PI * i / segments;
+    for (double radius : {0.8, 1.2})
+      points.emplace_back(radius * std::cos(angle), radius * std::sin(angle), 0.0);
+  }
+  std::vector<Triangle> band;
+  for (int i = 0; i < segments; ++i) {
+    const VertexIndex a = 2 * i, b = 2 * i + 1;
+    VertexIndex c = 2 * ((i + 1) % segments), d = c + 1;
+    if (i == segments - 1)
+      std::swap(c, d);
+    band.push_back({a, b, d});
+    band.push_back({a, d, c});
+  }
+  const std::vector<float> scale(points.size(), 1.0f);
+  const FinishedSurface surface = finishSurface(band, points, 0, SideLimit{&scale, 5.0});
+  EXPECT_LE(surface.twist_triangles_removed, 2u);
+  EXPECT_EQ(surface.triangles.size() + surface.twist_triangles_removed, band.size());
+  ASSERT_EQ(surface.component_orientable, std::vector<bool>{true});
+  expectCleanManifold(analyzeMesh(points, surface.triangles));
+}
+
 TEST(Finish, MoebiusStripIsReportedNonOrientable) {
   std::vector<Eigen::Vector3d> points;
   std::vector<Triangle> strip;

@@ -40,27 +40,15 @@ std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen:
 /// shared edges first: outward for closed components (positive signed
 /// volume), towards the viewpoint (when given) for the others. A component
 /// where no consistent orientation exists is reported and kept. Returns the
-/// triangles where a repair should cut: first one per inconsistent edge that
-/// folds by more than 90 degrees (its most crumpled corner's fan goes), then
-/// both triangles of each other inconsistent edge whose twist is local (a
-/// short orientation-reversing walk closes it) or, with a viewpoint, of
-/// every other inconsistent edge.
+/// triangles where a repair should cut: with a viewpoint, the more edge-on
+/// triangle of every inconsistent edge; without one, both triangles of each
+/// inconsistent edge that folds by more than 90 degrees or whose twist is
+/// local (a short orientation-reversing walk closes it).
 std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
                                             const std::vector<Eigen::Vector3d> &points,
                                             std::vector<std::uint32_t> &triangle_component,
                                             std::vector<bool> &component_orientable,
                                             const Eigen::Vector3d *viewpoint = nullptr);
-
-/// At each triangle that orientComponents reported (a sharp twist, e.g. a
-/// crumpled fan around a stray point), removes the most crumpled corner's
-/// fan and splits any bow-tie this leaves, so that hole filling can close the
-/// spot again. Returns how many triangles it removed; their corners are
-/// marked in touched. The fans of anchored vertices (corners of the user's
-/// initial triangles) are never removed.
-std::size_t removeTwistedFans(std::vector<Triangle> &triangles,
-                              const std::vector<Eigen::Vector3d> &points,
-                              const std::vector<std::uint32_t> &twisted, std::vector<bool> &touched,
-                              const std::vector<bool> *anchored_vertices = nullptr);
 
 /// Keeps one fan (the largest) at every touched vertex whose triangles form
 /// several, until none has more than one; the corners of removed triangles
