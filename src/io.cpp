@@ -749,6 +749,11 @@ bool loadPlyCloud(const std::string &path, std::uintmax_t size, pcl::PCLPointClo
   return true;
 }
 
+/// Whether a finite value is too large for the float the clouds store.
+bool outOfFloatRange(double value) {
+  return std::isfinite(value) && std::abs(value) > std::numeric_limits<float>::max();
+}
+
 /// A cloud of FLOAT32 columns (x y z [normal_x normal_y normal_z]) from
 /// `values`, `columns` per point.
 void makeFloatCloud(const std::vector<float> &values, std::size_t columns,
@@ -813,7 +818,7 @@ bool loadXyzCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::stri
         error = where + printable(word) + " is not a number";
         return false;
       }
-      if (std::isfinite(value) && std::abs(value) > std::numeric_limits<float>::max()) {
+      if (outOfFloatRange(value)) {
         error = where + printable(word) + " is out of float range";
         return false;
       }
@@ -1490,17 +1495,29 @@ bool hasNormals(const pcl::PCLPointCloud2 &cloud) {
 
 namespace {
 
+/// The mesh reader for the file's extension (faces may be absent).
+bool readMeshFile(const std::string &path, std::vector<Eigen::Vector3d> &vertices,
+                  std::vector<Triangle> &triangles, std::string &reason) {
+  const std::string extension = fileExtension(path);
+  if (extension == ".ply")
+    return loadPlyMesh(path, vertices, triangles, reason);
+  if (extension == ".obj")
+    return loadObjMesh(path, vertices, triangles, reason);
+  if (extension == ".off")
+    return loadOffMesh(path, vertices, triangles, reason);
+  if (extension == ".vtk")
+    return loadVtkMesh(path, vertices, triangles, reason);
+  reason = unknownFormat(extension, "mesh", ".ply, .obj, .off or .vtk");
+  return false;
+}
+
 /// The vertices of an .obj, .off or .vtk mesh as a cloud, in file order;
 /// faces may be absent (a vertex-only OFF is a point cloud).
 bool loadMeshVerticesCloud(const std::string &path, pcl::PCLPointCloud2 &cloud,
                            std::string &reason) {
   std::vector<Eigen::Vector3d> vertices;
   std::vector<Triangle> triangles;
-  const std::string extension = fileExtension(path);
-  const bool ok = extension == ".obj"   ? loadObjMesh(path, vertices, triangles, reason)
-                  : extension == ".off" ? loadOffMesh(path, vertices, triangles, reason)
-                                        : loadVtkMesh(path, vertices, triangles, reason);
-  if (!ok)
+  if (!readMeshFile(path, vertices, triangles, reason))
     return false;
   if (vertices.empty()) {
     reason = "the file contains no vertices";
@@ -1511,7 +1528,7 @@ bool loadMeshVerticesCloud(const std::string &path, pcl::PCLPointCloud2 &cloud,
   for (std::size_t i = 0; i < vertices.size(); ++i)
     for (int k = 0; k < 3; ++k) {
       const double value = vertices[i][k];
-      if (std::isfinite(value) && std::abs(value) > std::numeric_limits<float>::max()) {
+      if (outOfFloatRange(value)) {
         reason = "vertex " + std::to_string(i) + " is out of float range";
         return false;
       }
@@ -1567,20 +1584,8 @@ bool loadMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices,
   std::string reason;
   bool ok = false;
   try {
-    const std::string extension = fileExtension(path);
     std::uintmax_t size = 0;
-    if (!checkInputFile(path, size, reason))
-      ok = false;
-    else if (extension == ".ply")
-      ok = loadPlyMesh(path, vertices, triangles, reason);
-    else if (extension == ".obj")
-      ok = loadObjMesh(path, vertices, triangles, reason);
-    else if (extension == ".off")
-      ok = loadOffMesh(path, vertices, triangles, reason);
-    else if (extension == ".vtk")
-      ok = loadVtkMesh(path, vertices, triangles, reason);
-    else
-      reason = unknownFormat(extension, "mesh", ".ply, .obj, .off or .vtk");
+    ok = checkInputFile(path, size, reason) && readMeshFile(path, vertices, triangles, reason);
     if (ok && triangles.empty()) {
       reason = "the file contains no faces";
       ok = false;
