@@ -125,26 +125,18 @@ bool parseReconstructArguments(int argc, char **argv, ReconstructOptions &option
   if (options.help)
     return true;
 
-  const auto badValue = [&](const char *option) {
+  // A number option that is absent keeps its default; one given must parse.
+  const auto parseNumber = [&](const char *option, auto &value) {
     const int index = pcl::console::find_argument(argc, argv, option);
+    if (index < 0 || pcl::console::parse_argument(argc, argv, option, value) >= 0)
+      return true;
     error = std::string(option) + ": '" + argv[index + 1] + "' is not a valid number";
     return false;
   };
-  if (pcl::console::find_argument(argc, argv, "-rho") >= 0 &&
-      pcl::console::parse_argument(argc, argv, "-rho", options.rho) < 0)
-    return badValue("-rho");
-  if (pcl::console::find_argument(argc, argv, "-fill_holes") >= 0 &&
-      pcl::console::parse_argument(argc, argv, "-fill_holes", options.fill_holes) < 0)
-    return badValue("-fill_holes");
-  if (pcl::console::find_argument(argc, argv, "-threads") >= 0 &&
-      pcl::console::parse_argument(argc, argv, "-threads", options.threads) < 0)
-    return badValue("-threads");
-  if (pcl::console::find_argument(argc, argv, "-bucket_points") >= 0 &&
-      pcl::console::parse_argument(argc, argv, "-bucket_points", options.bucket_points) < 0)
-    return badValue("-bucket_points");
-  if (pcl::console::find_argument(argc, argv, "-grid") >= 0 &&
-      pcl::console::parse_argument(argc, argv, "-grid", options.grid) < 0)
-    return badValue("-grid");
+  if (!parseNumber("-rho", options.rho) || !parseNumber("-fill_holes", options.fill_holes) ||
+      !parseNumber("-threads", options.threads) ||
+      !parseNumber("-bucket_points", options.bucket_points) || !parseNumber("-grid", options.grid))
+    return false;
   if (const int index = pcl::console::find_argument(argc, argv, "-viewpoint"); index >= 0) {
     pcl::console::parse_x_arguments(argc, argv, "-viewpoint", options.viewpoint);
     if (options.viewpoint.size() != 3) {
@@ -152,9 +144,8 @@ bool parseReconstructArguments(int argc, char **argv, ReconstructOptions &option
       return false;
     }
   }
-  if (pcl::console::find_argument(argc, argv, "-time_limit") >= 0 &&
-      pcl::console::parse_argument(argc, argv, "-time_limit", options.time_limit) < 0)
-    return badValue("-time_limit");
+  if (!parseNumber("-time_limit", options.time_limit))
+    return false;
 
   if (positional.size() != 2) {
     error = "expected input and output file names, got " + std::to_string(positional.size()) +
