@@ -461,19 +461,16 @@ TEST(Finish, SameSurfaceForAnyNumberOfThreads) {
   }
 }
 
-TEST(Finish, TwistIsCutWhereTheBandFoldsOverItself) {
-  // A flat ring of quads whose last quad is glued with a half twist, i.e.
-  // crossed over itself: every edge is flat except around that quad. The
-  // inconsistent edge that orientation must leave belongs there, however
-  // far it is from where orientation starts (triangle 0).
-  const int segments = 40;
-  std::vector<Eigen::Vector3d> points;
+namespace {
+
+/// A flat ring of `segments` quads (radii 0.8 to 1.2) whose last quad is
+/// glued with a half twist, i.e. crossed over itself.
+void crossedBand(int segments, std::vector<Eigen::Vector3d> &points, std::vector<Triangle> &band) {
   for (int i = 0; i < segments; ++i) {
     const double angle = 2 * M_PI * i / segments;
     for (double radius : {0.8, 1.2})
       points.emplace_back(radius * std::cos(angle), radius * std::sin(angle), 0.0);
   }
-  std::vector<Triangle> band;
   for (int i = 0; i < segments; ++i) {
     const VertexIndex a = 2 * i, b = 2 * i + 1;
     VertexIndex c = 2 * ((i + 1) % segments), d = c + 1;
@@ -482,6 +479,19 @@ TEST(Finish, TwistIsCutWhereTheBandFoldsOverItself) {
     band.push_back({a, b, d});
     band.push_back({a, d, c});
   }
+}
+
+} // namespace
+
+TEST(Finish, TwistIsCutWhereTheBandFoldsOverItself) {
+  // A flat ring of quads whose last quad is glued with a half twist, i.e.
+  // crossed over itself: every edge is flat except around that quad. The
+  // inconsistent edge that orientation must leave belongs there, however
+  // far it is from where orientation starts (triangle 0).
+  const int segments = 40;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Triangle> band;
+  crossedBand(segments, points, band);
   std::vector<std::uint32_t> component;
   std::vector<bool> orientable;
   orientComponents(band, points, component, orientable);
@@ -509,22 +519,9 @@ TEST(Finish, FoldsLoseOnlyTheTrianglesAtTheInconsistentEdge) {
   // A flat annulus of quads with one quad crossed over itself: a sharp fold
   // that no orientation can get through. Cutting it must not cost more than
   // that quad's triangles (cutting the worst corner's fan, as before, took 3).
-  const int segments = 40;
   std::vector<Eigen::Vector3d> points;
-  for (int i = 0; i < segments; ++i) {
-    const double angle = 2 * M_PI * i / segments;
-    for (double radius : {0.8, 1.2})
-      points.emplace_back(radius * std::cos(angle), radius * std::sin(angle), 0.0);
-  }
   std::vector<Triangle> band;
-  for (int i = 0; i < segments; ++i) {
-    const VertexIndex a = 2 * i, b = 2 * i + 1;
-    VertexIndex c = 2 * ((i + 1) % segments), d = c + 1;
-    if (i == segments - 1)
-      std::swap(c, d);
-    band.push_back({a, b, d});
-    band.push_back({a, d, c});
-  }
+  crossedBand(40, points, band);
   const std::vector<float> scale(points.size(), 1.0f);
   const FinishedSurface surface = finishSurface(band, points, 0, SideLimit{&scale, 5.0});
   EXPECT_LE(surface.twist_triangles_removed, 2u);

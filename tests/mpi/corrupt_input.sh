@@ -5,10 +5,7 @@
 # non-zero (each records its own exit status), and rank 0 must say why.
 set -euo pipefail
 build=$1 mpiexec=$2 ranks=$3 input=$4
-mpirun_flags=(--oversubscribe)
-[[ $(id -u) == 0 ]] && mpirun_flags+=(--allow-run-as-root)
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+source "$(dirname "${BASH_SOURCE[0]}")/job_setup.sh"
 
 head -c $(($(stat -c %s "$input") / 2)) "$input" > "$work/truncated.pcd"
 "$mpiexec" "${mpirun_flags[@]}" -np "$ranks" bash -c \

@@ -6,10 +6,7 @@
 set -euo pipefail
 build=$1 mpiexec=$2 ranks=$3 input=$4
 shift 4
-mpirun_flags=(--oversubscribe)
-[[ $(id -u) == 0 ]] && mpirun_flags+=(--allow-run-as-root)
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+source "$(dirname "${BASH_SOURCE[0]}")/job_setup.sh"
 
 "$build/pcl_ms_reconstruct" "$input" "$work/one_process.ply" -q "$@"
 "$mpiexec" "${mpirun_flags[@]}" -np "$ranks" \
