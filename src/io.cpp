@@ -101,6 +101,18 @@ std::string printable(std::string_view word) {
   return out + "'";
 }
 
+/// True when `value` is a whole number in [low, high]; NaN and infinities are not.
+bool isWholeNumberIn(double value, double low, double high) {
+  return value >= low && value <= high && std::floor(value) == value;
+}
+
+/// A number from a file for an error message, in the shortest form that reads back.
+std::string printableNumber(double value) {
+  char text[32];
+  const auto [end, code] = std::to_chars(text, text + sizeof(text), value);
+  return code == std::errc() ? std::string(text, end) : std::string("?");
+}
+
 /// Checks that `path` names a readable, non-empty regular file.
 bool checkInputFile(const std::string &path, std::uintmax_t &size, std::string &error) {
   std::error_code code;
@@ -956,7 +968,7 @@ bool loadPlyMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices
         bool ok = reader.read(property.is_list ? property.count_type : property.value_type, value);
         if (ok && property.is_list) {
           const bool keep = static_cast<int>(p) == corner_list;
-          if (value < 0 || value > 1e6) {
+          if (!isWholeNumberIn(value, 0, 1e6)) {
             error = "corrupt PLY file: list of " + std::to_string(value) + " items in element '" +
                     element.name + "' record " + std::to_string(r);
             return false;
@@ -969,8 +981,7 @@ bool loadPlyMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices
             if (!ok || !keep)
               continue;
             // -1 separates triangle strips; anything else must be an index.
-            if (!(value >= -1 && value <= std::numeric_limits<VertexIndex>::max()) ||
-                value != std::floor(value)) {
+            if (!isWholeNumberIn(value, -1, std::numeric_limits<VertexIndex>::max())) {
               error = "corrupt PLY file: vertex index " + std::to_string(value) + " in element '" +
                       element.name + "' record " + std::to_string(r);
               return false;
@@ -1384,7 +1395,7 @@ private:
       offsets.push_back(0);
       std::size_t at = 0;
       for (std::uint64_t c = 0; c < cell_count; ++c) {
-        if (at >= cells.size() || cells[at] < 0 || at + 1 + cells[at] > cells.size()) {
+        if (at >= cells.size() || !isWholeNumberIn(cells[at], 0, cells.size() - at - 1)) {
           error = "corrupt VTK cell list";
           return false;
         }
@@ -1397,10 +1408,18 @@ private:
     }
     if (!polygons && !strips)
       return true;
+    // Values are read as doubles; anything not a whole number in range would
+    // make the integer conversions below undefined.
+    for (double corner : connectivity)
+      if (!isWholeNumberIn(corner, 0, static_cast<double>(vertex_count) - 1)) {
+        error = "VTK cell references vertex " + printableNumber(corner) + " but there are " +
+                std::to_string(vertex_count) + " vertices";
+        return false;
+      }
     std::vector<std::int64_t> corners;
     for (std::size_t c = 0; c + 1 < offsets.size(); ++c) {
-      if (offsets[c] < 0 || offsets[c] > offsets[c + 1] ||
-          offsets[c + 1] > static_cast<double>(connectivity.size())) {
+      if (!isWholeNumberIn(offsets[c], 0, static_cast<double>(connectivity.size())) ||
+          !isWholeNumberIn(offsets[c + 1], offsets[c], static_cast<double>(connectivity.size()))) {
         error = "corrupt VTK cell offsets";
         return false;
       }

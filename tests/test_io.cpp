@@ -596,6 +596,19 @@ TEST_F(IoLoadMesh, BadIndicesAndShortFilesFail) {
                                "property list uchar int vertex_indices\nend_header\n"
                                "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n");
   EXPECT_TRUE(contains(expectMeshFailure(path("index.ply")), "vertex 3"));
+  // VTK values are read as numbers: indices past any integer type, fractions
+  // and NaN must be refused before they are converted.
+  const std::string vtk_head = "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\n"
+                               "POINTS 4 float\n0 0 0 1 0 0 0 1 0 1 1 0\n";
+  writeFile(path("huge.vtk"), vtk_head + "TRIANGLE_STRIPS 1 5\n4 4e37 1 0 1\n");
+  EXPECT_TRUE(contains(expectMeshFailure(path("huge.vtk")), "vertex 4e+37"));
+  writeFile(path("fraction.vtk"), vtk_head + "POLYGONS 1 4\n3 0 1.5 2\n");
+  EXPECT_TRUE(contains(expectMeshFailure(path("fraction.vtk")), "vertex 1.5"));
+  writeFile(path("nan_size.vtk"), vtk_head + "POLYGONS 1 4\nnan 0 1 2\n");
+  EXPECT_TRUE(contains(expectMeshFailure(path("nan_size.vtk")), "corrupt VTK cell list"));
+  writeFile(path("nan_offset.vtk"), vtk_head + "POLYGONS 2 3\nOFFSETS vtktypeint64\n0 nan\n"
+                                               "CONNECTIVITY vtktypeint64\n0 1 2\n");
+  EXPECT_TRUE(contains(expectMeshFailure(path("nan_offset.vtk")), "offsets"));
 }
 
 TEST_F(IoLoadMesh, PointCloudFilesHaveNoFaces) {
