@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Tests of pcl_ms/io.h (suites Io*) and of the pcl_ms_reconstruct program
 // (suite App). Every file they write goes to a fresh temporary directory.
+#include "finite_vertices.h"
 #include "program_test.h"
 #include "synthetic_clouds.h"
 #include "test_support.h"
@@ -8,15 +9,18 @@
 #include <pcl_ms/io.h>
 
 #include <gtest/gtest.h>
+#include <pcl/common/point_tests.h>
 #include <pcl/conversions.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
 #include <pcl/point_types.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <string>
@@ -860,6 +864,72 @@ TEST_F(App, ViewpointFromThePcdOrGivenOrNone) {
   EXPECT_FALSE(contains(stdout_, "viewpoint")) << stdout_;
   expectFailure(input + " -viewpoint 1,2", "-viewpoint");
   expectFailure(input + " -viewpoint 0,nan,1", "viewpoint must be finite");
+}
+
+TEST_F(App, DepthFrameFilesLeaveOutPointsWithoutPositionUnlessKeepLayout) {
+  // An organized frame with NaN where the rays miss: mesh viewers cannot
+  // read NaN vertices, so by default they stay out of the file.
+  const auto scan = pcl_ms_tools::oneViewScanOfBoxOnPlane(80, 60);
+  ASSERT_EQ(pcl::io::savePCDFileBinary(path("scan.pcd"), scan.cloud), 0);
+  std::size_t finite_points = 0;
+  for (const auto &point : scan.cloud.points)
+    finite_points += pcl::isFinite(point);
+  ASSERT_LT(finite_points, scan.cloud.size());
+  // The triangles as corner positions, comparable across vertex numberings.
+  auto trianglesAsPositions = [&](const std::string &file, std::size_t expected_vertices) {
+    std::vector<Eigen::Vector3d> vertices;
+    std::vector<pcl_ms::Triangle> triangles;
+    std::string error;
+    EXPECT_TRUE(pcl_ms::loadMesh(path(file), vertices, triangles, error)) << error;
+    EXPECT_EQ(vertices.size(), expected_vertices);
+    std::vector<std::array<double, 9>> positions;
+    for (const pcl_ms::Triangle &triangle : triangles) {
+      std::array<double, 9> corners;
+      for (int k = 0; k < 3; ++k)
+        for (int axis = 0; axis < 3; ++axis)
+          corners[3 * k + axis] = vertices[triangle[k]][axis];
+      positions.push_back(corners);
+    }
+    return positions;
+  };
+  ASSERT_EQ(run(quoted(path("scan.pcd")) + " " + quoted(path("compact.ply")) + " -q"), 0)
+      << stderr_;
+  ASSERT_EQ(run(quoted(path("scan.pcd")) + " " + quoted(path("layout.ply")) + " -q -keep_layout"),
+            0)
+      << stderr_;
+  const auto compact = trianglesAsPositions("compact.ply", finite_points);
+  const auto layout = trianglesAsPositions("layout.ply", scan.cloud.size());
+  EXPECT_GT(compact.size(), 1000u);
+  EXPECT_EQ(compact, layout);
+}
+
+TEST(FiniteVertices, DropsOnlyUnusedPointsWithoutPosition) {
+  pcl::PointCloud<pcl::PointXYZ> points;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  points.push_back({nan, 0, 0});
+  points.push_back({0, 0, 0});
+  points.push_back({1, 0, 0});
+  points.push_back({0, nan, nan});
+  points.push_back({0, 1, 0});
+  points.width = 5;
+  points.height = 1;
+  points.is_dense = false;
+  pcl::PolygonMesh mesh;
+  pcl::toPCLPointCloud2(points, mesh.cloud);
+  pcl::Vertices triangle;
+  triangle.vertices = {1, 2, 4};
+  mesh.polygons = {triangle};
+  EXPECT_EQ(pcl_ms_tools::dropNonFiniteVertices(mesh), 2u);
+  EXPECT_EQ(mesh.cloud.width * mesh.cloud.height, 3u);
+  EXPECT_TRUE(mesh.cloud.is_dense);
+  const std::vector<pcl::index_t> expected = {0, 1, 2};
+  EXPECT_EQ(mesh.polygons[0].vertices, expected);
+  pcl::PointCloud<pcl::PointXYZ> kept;
+  pcl::fromPCLPointCloud2(mesh.cloud, kept);
+  EXPECT_EQ(kept[2].y, 1.0f);
+  // Nothing to drop: the mesh stays as it is.
+  EXPECT_EQ(pcl_ms_tools::dropNonFiniteVertices(mesh), 0u);
+  EXPECT_EQ(mesh.cloud.width, 3u);
 }
 
 TEST_F(App, HelpExitsCleanly) {

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "reconstruct_cli.h"
 
+#include "finite_vertices.h"
+
 #include <pcl_ms/buckets.h>
 #include <pcl_ms/io.h>
 
@@ -88,6 +90,9 @@ void printReconstructHelp(const char *program, const char *summary) {
   print_info("  -no_viewpoint   no viewpoint, even for an organized cloud\n");
   print_info("  -time_limit S   give up after S seconds with an error and no output file,\n"
              "                  0 = no limit (default 0)\n");
+  print_info("  -keep_layout    write every point of the cloud, in its order and organized\n"
+             "                  layout, points without a position (NaN) too (default: those\n"
+             "                  are left out of the file, which mesh viewers cannot read)\n");
   print_info("  -q              quiet: print nothing but errors\n");
   print_info("  -h              this help\n\n");
   print_info("Exit status: 0 success, 1 bad arguments, 2 file error, 3 reconstruction failed.\n");
@@ -108,6 +113,8 @@ bool parseReconstructArguments(int argc, char **argv, ReconstructOptions &option
       options.quiet = true;
     } else if (argument == "-no_viewpoint") {
       options.no_viewpoint = true;
+    } else if (argument == "-keep_layout") {
+      options.keep_layout = true;
     } else if (std::find(value_options.begin(), value_options.end(), argument) !=
                value_options.end()) {
       if (i + 1 >= argc) {
@@ -239,6 +246,8 @@ int saveReconstructedMesh(const ReconstructOptions &options, pcl::PCLPointCloud2
   // The output keeps every field of the user's points, not just x, y, z.
   mesh.header = cloud.header;
   mesh.cloud = std::move(cloud);
+  if (!options.keep_layout)
+    dropNonFiniteVertices(mesh);
   const bool verbose = !options.quiet;
   if (!fileStep("Saving", options.output, verbose, save_ms,
                 [&] { return pcl_ms::saveMesh(options.output, mesh, error); }))

@@ -30,6 +30,7 @@ struct ReconstructOptions {
   bool no_viewpoint = false;
   double time_limit = 0; // seconds, 0: none
   bool quiet = false;
+  bool keep_layout = false; // write the cloud's points as they are, NaN rows too
   bool help = false;
 };
 
@@ -58,7 +59,8 @@ int loadReconstructInput(const ReconstructOptions &options, pcl_ms::Parameters &
 void printReconstructStart(const ReconstructOptions &options, const pcl_ms::Parameters &parameters);
 
 /// Saves the mesh (polygons index `cloud`, which it takes over) with the
-/// "Saving" line; kSuccess or kIoFailure with `error` set.
+/// "Saving" line, without the cloud's points that have no position unless
+/// `options.keep_layout`; kSuccess or kIoFailure with `error` set.
 int saveReconstructedMesh(const ReconstructOptions &options, pcl::PCLPointCloud2 &&cloud,
                           std::vector<pcl::Vertices> &&polygons, double &save_ms,
                           std::string &error);
