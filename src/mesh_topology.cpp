@@ -2,6 +2,8 @@
 #include <pcl_ms/mesh_topology.h>
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 namespace pcl_ms {
 
@@ -16,7 +18,10 @@ std::array<EdgeIndex, 2> MeshTopology::edgesAt(CandidateIndex t, VertexIndex v) 
   for (int k = 0; k < 3; ++k)
     if (candidate.vertices[k] == v)
       return {candidate.edges[k], candidate.edges[(k + 2) % 3]};
-  return {0, 0};
+  // Callers walk the triangles around v; anything else is a broken invariant,
+  // which must stop the run rather than quietly use some edge.
+  throw std::logic_error("MeshTopology::edgesAt: vertex " + std::to_string(v) +
+                         " is not a corner of candidate " + std::to_string(t));
 }
 
 void MeshTopology::add(CandidateIndex t) {

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <map>
 #include <set>
+#include <stdexcept>
 
 using namespace pcl_ms;
 using pcl_ms_test::expectCleanManifold;
@@ -260,6 +261,19 @@ TEST(MeshTopology, CountsFollowAddAndRemove) {
   EXPECT_FALSE(mesh.contains(3));
   for (VertexIndex v : scaffold.candidates[3].vertices)
     EXPECT_FALSE(mesh.isClosedVertex(v));
+}
+
+TEST(MeshTopology, EdgesAtAVertexThatIsNoCornerIsAnErrorNotEdgeZero) {
+  const MedialScaffold scaffold = buildMedialScaffold(regularTetrahedron(), {});
+  const MeshTopology mesh(scaffold, 4);
+  const auto &corners = scaffold.candidates[0].vertices;
+  const auto edges = mesh.edgesAt(0, corners[1]);
+  EXPECT_EQ(edges[0], scaffold.candidates[0].edges[1]);
+  EXPECT_EQ(edges[1], scaffold.candidates[0].edges[0]);
+  VertexIndex missing = 0;
+  while (std::find(corners.begin(), corners.end(), missing) != corners.end())
+    ++missing;
+  EXPECT_THROW(mesh.edgesAt(0, missing), std::logic_error);
 }
 
 namespace {

@@ -74,7 +74,7 @@ void printReconstructHelp(const char *program, const char *summary) {
   print_info(")\n");
   print_info("  -normals        use the cloud's normal_x/y/z fields to guide the surface\n");
   print_info("  -threads N      threads for the parallel stages, 0 = all cores (default ");
-  print_value("1");
+  print_value("%d", pcl_ms::Parameters().num_threads);
   print_info(")\n");
   print_info("  -bucket_points M  mesh clouds larger than M points in buckets of about M points,\n"
              "                  stitched together; 0 = automatic: buckets of ");

@@ -23,7 +23,7 @@ struct ReconstructOptions {
   double rho = pcl_ms::Parameters().rho;
   int fill_holes = pcl_ms::Parameters().fill_holes_max_edges;
   bool normals = false;
-  int threads = 1;
+  int threads = pcl_ms::Parameters().num_threads;
   unsigned int bucket_points = 0; // 0: automatic
   int grid = 0;
   std::vector<double> viewpoint; // empty, or x, y, z

@@ -91,7 +91,8 @@ public:
   /// found by walking the fan without building it.
   bool isSingleFan(VertexIndex v) const;
 
-  /// The two edges of candidate t that contain vertex v.
+  /// The two edges of candidate t that contain vertex v; std::logic_error
+  /// when v is not a corner of t.
   std::array<EdgeIndex, 2> edgesAt(CandidateIndex t, VertexIndex v) const;
 
   std::size_t size() const { return triangle_count_; }

@@ -11,6 +11,9 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <exception>
+#include <new>
+#include <string>
 
 namespace pcl {
 
@@ -110,10 +113,19 @@ bool MedialScaffoldReconstruction<PointInT>::runCore(std::vector<pcl::Vertices> 
       (input_->isOrganized() || origin.head<3>() != Eigen::Vector3f::Zero()))
     parameters.viewpoint = {{origin[0], origin[1], origin[2]}};
 
+  bool failed = true;
   try {
     result_ = pcl_ms::reconstruct(view, parameters, initial);
+    failed = false;
   } catch (const pcl_ms::ReconstructionError &error) {
     error_message_ = error.what();
+  } catch (const std::bad_alloc &) {
+    error_message_ = "out of memory";
+  } catch (const std::exception &error) {
+    // Nothing may escape a PCL algorithm: a failure is reported like any other.
+    error_message_ = std::string("unexpected failure: ") + error.what();
+  }
+  if (failed) {
     PCL_ERROR("[pcl::%s::reconstruct] %s\n", getClassName().c_str(), error_message_.c_str());
     return false;
   }
