@@ -92,8 +92,9 @@ int run(int argc, char **argv) {
   std::vector<pcl::Vertices> polygons;
   pcl_ms::Result result;
   const bool reconstructed =
-      options.normals ? reconstructAs<pcl::PointNormal>(cloud, parameters, polygons, result, error)
-                      : reconstructAs<pcl::PointXYZ>(cloud, parameters, polygons, result, error);
+      parameters.use_normals
+          ? reconstructAs<pcl::PointNormal>(cloud, parameters, polygons, result, error)
+          : reconstructAs<pcl::PointXYZ>(cloud, parameters, polygons, result, error);
   const double reconstruct_ms = timer.toc();
   if (!reconstructed) {
     if (verbose)

@@ -184,7 +184,7 @@ int run(const Job &job, int argc, char **argv) {
       std::fprintf(stderr, "  all ranks: %s done, %.1f s elapsed\n", stage.c_str(),
                    secondsSinceStart());
   });
-  const pcl_ms::Result result = options.normals
+  const pcl_ms::Result result = parameters.use_normals
                                     ? meshAs<pcl::PointNormal>(job, cloud, parameters, exchange)
                                     : meshAs<pcl::PointXYZ>(job, cloud, parameters, exchange);
   std::vector<pcl::Vertices> polygons(result.triangles.size());

@@ -2,6 +2,7 @@
 // Tests of pcl_ms/io.h (suites Io*) and of the pcl_ms_reconstruct program
 // (suite App). Every file they write goes to a fresh temporary directory.
 #include "finite_vertices.h"
+#include "normal_estimation.h"
 #include "program_test.h"
 #include "synthetic_clouds.h"
 #include "test_support.h"
@@ -17,10 +18,12 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -930,6 +933,53 @@ TEST(FiniteVertices, DropsOnlyUnusedPointsWithoutPosition) {
   // Nothing to drop: the mesh stays as it is.
   EXPECT_EQ(pcl_ms_tools::dropNonFiniteVertices(mesh), 0u);
   EXPECT_EQ(mesh.cloud.width, 3u);
+}
+
+TEST(NormalEstimation, PlaneNormalsFaceTheViewpointAndMissingPointsGetNone) {
+  pcl::PointCloud<pcl::PointXYZ> points;
+  for (int row = 0; row < 10; ++row)
+    for (int column = 0; column < 10; ++column)
+      points.push_back({0.1f * column, 0.1f * row, 0.0f});
+  points[37].x = std::numeric_limits<float>::quiet_NaN();
+  points.width = 10;
+  points.height = 10;
+  points.is_dense = false;
+  pcl::PCLPointCloud2 cloud;
+  pcl::toPCLPointCloud2(points, cloud);
+  std::string error;
+  ASSERT_TRUE(pcl_ms_tools::estimateNormals(cloud, 8, std::array<double, 3>{0.5, 0.5, -3.0}, error))
+      << error;
+  ASSERT_TRUE(pcl_ms::hasNormals(cloud));
+  pcl::PointCloud<pcl::PointNormal> with_normals;
+  pcl::fromPCLPointCloud2(cloud, with_normals);
+  ASSERT_EQ(with_normals.size(), 100u);
+  for (std::size_t i = 0; i < with_normals.size(); ++i) {
+    if (i == 37) {
+      EXPECT_TRUE(std::isnan(with_normals[i].normal_z));
+      continue;
+    }
+    EXPECT_NEAR(with_normals[i].normal_z, -1.0f, 1e-4f) << i; // towards z = -3
+  }
+  // Normals are not estimated twice, nor from fewer than 3 neighbours.
+  EXPECT_FALSE(pcl_ms_tools::estimateNormals(cloud, 8, std::nullopt, error));
+  EXPECT_TRUE(contains(error, "already has normals")) << error;
+  pcl::toPCLPointCloud2(points, cloud);
+  EXPECT_FALSE(pcl_ms_tools::estimateNormals(cloud, 2, std::nullopt, error));
+}
+
+TEST_F(App, EstimatedNormalsGuideTheSurface) {
+  const std::string files = "'" + kDataDir + "/bunny.pcd' '" + path("out.ply") + "'";
+  ASSERT_EQ(run(files + " -estimate_normals 10"), 0) << stderr_;
+  EXPECT_TRUE(contains(stdout_, "normals estimated (10 neighbours)")) << stdout_;
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<pcl_ms::Triangle> triangles;
+  std::string error;
+  ASSERT_TRUE(pcl_ms::loadMesh(path("out.ply"), vertices, triangles, error)) << error;
+  EXPECT_GT(triangles.size(), 70000u); // the bunny's 35,947 points, closed but for its base
+  expectFailure(files + " -estimate_normals 2", "at least 3 neighbours");
+  expectFailure(files + " -estimate_normals 10 -normals", "exclude each other");
+  expectFailure("'" + kDataDir + "/bun0.pcd' '" + path("out.ply") + "' -estimate_normals 10",
+                "already has normals");
 }
 
 TEST_F(App, HelpExitsCleanly) {

@@ -2,6 +2,7 @@
 #include "reconstruct_cli.h"
 
 #include "finite_vertices.h"
+#include "normal_estimation.h"
 
 #include <pcl_ms/buckets.h>
 #include <pcl_ms/io.h>
@@ -73,6 +74,8 @@ void printReconstructHelp(const char *program, const char *summary) {
   print_value("%d", pcl_ms::Parameters().fill_holes_max_edges);
   print_info(")\n");
   print_info("  -normals        use the cloud's normal_x/y/z fields to guide the surface\n");
+  print_info("  -estimate_normals K  estimate normals from each point's K nearest neighbours\n"
+             "                  (PCL's NormalEstimation) and use them as -normals does\n");
   print_info("  -threads N      threads for the parallel stages, 0 = all cores (default ");
   print_value("%d", pcl_ms::Parameters().num_threads);
   print_info(")\n");
@@ -101,7 +104,8 @@ void printReconstructHelp(const char *program, const char *summary) {
 bool parseReconstructArguments(int argc, char **argv, ReconstructOptions &options,
                                std::string &error) {
   const std::vector<std::string> value_options = {
-      "-rho", "-fill_holes", "-threads", "-bucket_points", "-grid", "-viewpoint", "-time_limit"};
+      "-rho",  "-fill_holes", "-threads",    "-bucket_points",
+      "-grid", "-viewpoint",  "-time_limit", "-estimate_normals"};
   std::vector<std::string> positional;
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
@@ -151,8 +155,19 @@ bool parseReconstructArguments(int argc, char **argv, ReconstructOptions &option
       return false;
     }
   }
-  if (!parseNumber("-time_limit", options.time_limit))
+  if (!parseNumber("-time_limit", options.time_limit) ||
+      !parseNumber("-estimate_normals", options.estimate_normals))
     return false;
+  if (pcl::console::find_argument(argc, argv, "-estimate_normals") >= 0 &&
+      options.estimate_normals < 3) {
+    error = "-estimate_normals: at least 3 neighbours are needed (got " +
+            std::to_string(options.estimate_normals) + ")";
+    return false;
+  }
+  if (options.normals && options.estimate_normals > 0) {
+    error = "-normals and -estimate_normals exclude each other";
+    return false;
+  }
 
   if (positional.size() != 2) {
     error = "expected input and output file names, got " + std::to_string(positional.size()) +
@@ -168,7 +183,7 @@ std::string reconstructParameters(const ReconstructOptions &options,
                                   pcl_ms::Parameters &parameters) {
   parameters.rho = options.rho;
   parameters.fill_holes_max_edges = options.fill_holes;
-  parameters.use_normals = options.normals;
+  parameters.use_normals = options.normals || options.estimate_normals > 0;
   parameters.num_threads = options.threads;
   parameters.bucket_points = options.bucket_points;
   parameters.grid_buckets = options.grid;
@@ -212,6 +227,20 @@ int loadReconstructInput(const ReconstructOptions &options, pcl_ms::Parameters &
   }
   if (!parameters.viewpoint && !options.no_viewpoint)
     parameters.viewpoint = sensorViewpoint(cloud, sensor_origin);
+  if (options.estimate_normals > 0) {
+    double estimate_ms = 0;
+    if (!fileStep("Estimating normals of", options.input, verbose, estimate_ms, [&] {
+          return estimateNormals(cloud, options.estimate_normals, parameters.viewpoint, error);
+        }))
+      return kBadArguments;
+    if (verbose) {
+      print_info("[done, ");
+      print_value("%.1f", estimate_ms);
+      print_info(" ms : ");
+      print_value("%d", options.estimate_normals);
+      print_info(" neighbours]\n");
+    }
+  }
   if (options.normals && !pcl_ms::hasNormals(cloud)) {
     error = "-normals was given but " + options.input +
             " has no float normal_x, normal_y, normal_z fields";
@@ -227,7 +256,10 @@ void printReconstructStart(const ReconstructOptions &options,
   print_info(", fill holes ");
   print_value("%d", options.fill_holes);
   print_info(", normals ");
-  print_value("%s", options.normals ? "on" : "off");
+  if (options.estimate_normals > 0)
+    print_value("estimated (%d neighbours)", options.estimate_normals);
+  else
+    print_value("%s", options.normals ? "on" : "off");
   print_info(", threads ");
   print_value("%d", options.threads);
   if (parameters.viewpoint) {
