@@ -14,6 +14,7 @@
 #include <CGAL/Simple_cartesian.h>
 
 #include <Eigen/Geometry>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -24,7 +25,6 @@
 #include <numeric>
 #include <optional>
 #include <random>
-#include <thread>
 #include <tuple>
 #include <unordered_map>
 #include <utility>
@@ -691,24 +691,15 @@ public:
 
     constexpr std::size_t kBlock = 256;
     const std::size_t block_count = (order.size() + kBlock - 1) / kBlock;
-    auto work = [&](std::size_t first_block, std::size_t stride) {
-      for (std::size_t block = first_block; block < block_count; block += stride) {
-        Hints hints;
-        const std::size_t end = std::min(order.size(), (block + 1) * kBlock);
-        for (std::size_t k = block * kBlock; k < end; ++k)
-          result[order[k]] = std::sqrt(squaredDistance(samples.points[order[k]], hints));
-      }
-    };
-    constexpr std::size_t kBlocksPerThread = 64;
-    const std::size_t thread_count = std::clamp<std::size_t>(
-        std::min<std::size_t>(std::thread::hardware_concurrency(), block_count / kBlocksPerThread),
-        1, 16);
-    std::vector<std::thread> threads;
-    for (std::size_t thread = 1; thread < thread_count; ++thread)
-      threads.emplace_back(work, thread, thread_count);
-    work(0, thread_count);
-    for (std::thread &thread : threads)
-      thread.join();
+    // TBB, like the reconstruction: the caller's task arena (and its thread
+    // limit) applies. Each block has its own hints and writes its own
+    // entries, so the result does not depend on the scheduling.
+    tbb::parallel_for(std::size_t{0}, block_count, [&](std::size_t block) {
+      Hints hints;
+      const std::size_t end = std::min(order.size(), (block + 1) * kBlock);
+      for (std::size_t k = block * kBlock; k < end; ++k)
+        result[order[k]] = std::sqrt(squaredDistance(samples.points[order[k]], hints));
+    });
     return result;
   }
 
