@@ -280,7 +280,12 @@ std::vector<std::vector<VertexIndex>> boundaryLoops(const EdgeUses &uses) {
   return loops;
 }
 
-/// fillHoles() given the mesh's boundary loops.
+/// Closes loops of at most max_edges edges with triangles of the Delaunay
+/// triangulation of the loop's vertices (minimum total P / C^2, no edge
+/// that the mesh already has inside the hole, sides below the limit except
+/// for a triangular hole), or any triangles when those cannot fill it
+/// (docs/algorithm.md, "Finishing"). Only simple loops; with only_around,
+/// only loops through a vertex marked there. Returns the holes closed.
 std::size_t fillLoops(std::vector<Triangle> &triangles, std::vector<std::vector<VertexIndex>> loops,
                       const std::vector<Eigen::Vector3d> &points, int max_edges,
                       const SideLimit &limit, const std::vector<bool> *only_around) {
@@ -361,13 +366,6 @@ std::vector<std::vector<VertexIndex>> traceBoundaryLoops(const std::vector<Trian
   return boundaryLoops(edgeUses(triangles));
 }
 
-std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen::Vector3d> &points,
-                      int max_edges, const SideLimit &limit, const std::vector<bool> *only_around) {
-  if (max_edges < 3)
-    return 0;
-  return fillLoops(triangles, traceBoundaryLoops(triangles), points, max_edges, limit, only_around);
-}
-
 namespace {
 
 /// Union-find over triangles that keeps each triangle's flip relative to its
@@ -425,8 +423,8 @@ private:
 // orientation, this one leaves few pairs to sort on a smooth surface.
 constexpr double kruskal_flat_bending = 0.5;
 
-/// Two triangles sharing a manifold edge, and how much the surface bends
-/// there (computed only where orientation needs it).
+/// Two triangles sharing a manifold edge and the edge's end points (how much
+/// the surface bends there is bendingAt(), computed where orientation needs it).
 struct ManifoldPair {
   std::uint32_t first, second;
   VertexIndex a, b; // the shared edge

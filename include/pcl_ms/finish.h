@@ -27,15 +27,6 @@ struct FinishedSurface {
 /// smallest vertex, in order of that vertex.
 std::vector<std::vector<VertexIndex>> traceBoundaryLoops(const std::vector<Triangle> &triangles);
 
-/// Closes loops of at most max_edges edges with triangles of the Delaunay
-/// triangulation of the loop's vertices (minimum total P / C^2, no edge
-/// that the mesh already has inside the hole, sides below the limit except
-/// for a triangular hole). Only simple loops; with only_around, only loops
-/// through a vertex marked there. Returns the holes closed.
-std::size_t fillHoles(std::vector<Triangle> &triangles, const std::vector<Eigen::Vector3d> &points,
-                      int max_edges, const SideLimit &limit,
-                      const std::vector<bool> *only_around = nullptr);
-
 /// Orients every component consistently, spreading across the flattest
 /// shared edges first: outward for closed components (positive signed
 /// volume), towards the viewpoint (when given) for the others. A component

@@ -74,8 +74,9 @@ public:
   using VertexTriangles = boost::container::small_vector<CandidateIndex, 8>;
 
   const VertexTriangles &vertexTriangles(VertexIndex v) const { return vertex_triangles_[v]; }
-  /// Edges at v with exactly one triangle.
+  /// Accepted triangles at v.
   std::size_t vertexTriangleCount(VertexIndex v) const { return vertex_counts_[v].triangles; }
+  /// Edges at v with exactly one triangle.
   int vertexBoundaryEdges(VertexIndex v) const {
     return static_cast<int>(vertex_counts_[v].boundary_edges);
   }
