@@ -161,21 +161,40 @@ private:
   }
 
   /// Preferred triangles (docs/algorithm.md, "Initial triangles") go first,
-  /// alone in Q1 and ranked among themselves by their own costs, so that
-  /// of two conflicting ones the better-shaped wins. From then on their base
-  /// cost is 0: an ordinary candidate undoes one only where its context
-  /// (how sharply it bends against its accepted neighbours) makes it
-  /// costlier. Those demoted or rejected here are ordinary candidates too.
+  /// alone in Q1, in four rounds: those whose three edges the soup agrees on
+  /// (each shared with exactly one other preferred triangle), then two, one,
+  /// none; within a round by their own costs. A wrong triangle overlapping
+  /// right ones puts a third triangle on their edges, so it comes after them
+  /// and finds its edges full. From then on the base cost of the accepted
+  /// ones is 0: an ordinary candidate undoes one only where its context (how
+  /// sharply it bends against its accepted neighbours) makes it costlier.
+  /// Those not accepted in these rounds are ordinary candidates.
   void rankPreferredTriangles() {
     if (scaffold_.preferred.empty())
       return;
+    // How many preferred triangles each edge has: an edge with exactly two is
+    // one the soup agrees on.
+    std::vector<std::uint8_t> on_edge(scaffold_.numberOfEdges(), 0);
+    for (CandidateIndex t : scaffold_.preferred)
+      if (is_preferred_[t])
+        for (EdgeIndex e : candidates_[t].edges)
+          on_edge[e] = static_cast<std::uint8_t>(std::min(on_edge[e] + 1, 3));
+    std::vector<CandidateIndex> tiers[4];
     for (CandidateIndex t : scaffold_.preferred) {
       if (!is_preferred_[t])
         continue;
-      states_[t].cost = static_cast<float>(freshCost(t));
-      push(t, State::queue1);
+      int agreed = 0;
+      for (EdgeIndex e : candidates_[t].edges)
+        agreed += on_edge[e] == 2;
+      tiers[3 - agreed].push_back(t);
     }
-    runPass(State::queue1, statistics_.pass1);
+    for (const auto &tier : tiers) {
+      for (CandidateIndex t : tier) {
+        states_[t].cost = static_cast<float>(freshCost(t));
+        push(t, State::queue1);
+      }
+      runPass(State::queue1, statistics_.pass1);
+    }
     preferred_ranked_ = true;
     for (CandidateIndex t : scaffold_.preferred) {
       if (states_[t].state != State::accepted) {

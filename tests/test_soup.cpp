@@ -184,6 +184,9 @@ TEST(InitialTrianglesSoup, PreferredModeCleansABunnySoupWithTenPercentWrong) {
 
   EXPECT_GE(static_cast<double>(right_kept), 0.99 * soup.right.size());
   EXPECT_EQ(crossing_kept, 0u);
+  // Overlapping ones come after the right ones they overlap and lose (1
+  // of 1,388 kept, measured, and that one is also a triangle of the mesh).
+  EXPECT_LE(overlapping_kept, soup.overlapping.size() / 100);
   // The repeats, and the few wrong triangles that happen to be another one.
   EXPECT_EQ(result.initial_duplicates, soup.triangles.size() - sortedSet(soup.triangles).size());
   EXPECT_GE(result.initial_duplicates, soup.repeats);
