@@ -48,6 +48,10 @@ std::string Parameters::validate() const {
   else if (!(std::isfinite(time_limit_seconds) && time_limit_seconds >= 0))
     reason << "time limit must be 0 (none) or a number of seconds > 0 (got " << time_limit_seconds
            << ")";
+  else if (initial_triangles_mode != InitialTrianglesMode::fixed &&
+           initial_triangles_mode != InitialTrianglesMode::preferred)
+    reason << "initial triangles mode must be fixed or preferred (got "
+           << static_cast<int>(initial_triangles_mode) << ")";
   else if (grid_buckets < 0 || grid_buckets > max_grid_buckets)
     reason << "grid buckets must be in [0, " << max_grid_buckets << "] (got " << grid_buckets
            << ")";

@@ -306,6 +306,20 @@ TEST_F(AppInitial, ReconstructTakesAnInitialMeshInEitherMode) {
   EXPECT_NE(runProgram(app, files + " -q"), 0);
   EXPECT_TRUE(contains(stderr_, "error: ")) << stderr_;
   EXPECT_TRUE(contains(stderr_, "twice")) << stderr_;
+  // Fixed mode takes a clean partial mesh: here bun0's own mesh, saved by
+  // the tool, as PLY.
+  const std::string bun0 = quoted(dataPath("bun0.pcd"));
+  ASSERT_EQ(runProgram(app, bun0 + " " + quoted(path("bun0.ply")) + " -q"), 0) << stderr_;
+  ASSERT_EQ(runProgram(app, bun0 + " " + quoted(path("again.ply")) + " -initial " +
+                                quoted(path("bun0.ply")) + " -initial_mode fixed"),
+            0)
+      << stderr_;
+  EXPECT_TRUE(contains(stdout_, "initial triangles fixed")) << stdout_;
+  std::vector<Triangle> first, again;
+  ASSERT_TRUE(pcl_ms::loadMesh(path("bun0.ply"), vertices, first, error)) << error;
+  ASSERT_TRUE(pcl_ms::loadMesh(path("again.ply"), vertices, again, error)) << error;
+  EXPECT_EQ(countIn(sortedSet(again), first), first.size());
+
   EXPECT_NE(runProgram(app, files + " -initial_mode sometimes"), 0);
   EXPECT_TRUE(contains(stderr_, "not fixed or preferred")) << stderr_;
   EXPECT_NE(runProgram(app, quoted(dataPath("bunny.pcd")) + " " + quoted(path("out.ply")) +
