@@ -48,9 +48,9 @@ constexpr EdgeIndex no_edge = std::numeric_limits<EdgeIndex>::max();
 struct MedialScaffold {
   std::vector<Candidate> candidates;
   /// The edge graph holds the candidates pass 1 looks at: types I and II and
-  /// the fixed and preferred ones, ascending on each edge. The other type III candidates,
-  /// the majority but rarely kept, wait outside it with edges no_edge:
-  /// GreedyMesher numbers those that reach pass 2.
+  /// the fixed and preferred ones, ascending on each edge. The other type III
+  /// candidates, the majority but rarely kept, wait outside it with edges
+  /// no_edge: GreedyMesher numbers those that reach pass 2.
   std::vector<std::uint32_t> edge_offsets; // edges + 1 entries
   std::vector<CandidateIndex> edge_candidates;
   /// Edge ids by end points: edge_vertex_offsets[a] is the id of a's first
