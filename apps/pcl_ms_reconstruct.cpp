@@ -32,13 +32,14 @@ using pcl_ms_tools::SilencePclMessages;
 /// index the cloud's points directly.
 template <typename PointT>
 bool reconstructAs(const pcl::PCLPointCloud2 &cloud, const pcl_ms::Parameters &parameters,
-                   std::vector<pcl::Vertices> &polygons, pcl_ms::Result &result,
-                   std::string &error) {
+                   const std::vector<pcl::Vertices> &initial, std::vector<pcl::Vertices> &polygons,
+                   pcl_ms::Result &result, std::string &error) {
   auto points = pcl::make_shared<pcl::PointCloud<PointT>>();
   pcl::fromPCLPointCloud2(cloud, *points);
   pcl::MedialScaffoldReconstruction<PointT> reconstruction;
   reconstruction.setInputCloud(points);
   reconstruction.setParameters(parameters);
+  reconstruction.setInitialTriangles(initial);
   reconstruction.setUseSensorOrigin(false); // run() decided the viewpoint
   pcl::PolygonMesh mesh;
   {
@@ -81,6 +82,12 @@ int run(int argc, char **argv) {
       code != kSuccess)
     return fail(code, error);
 
+  std::vector<pcl::Vertices> initial;
+  if (!options.initial.empty())
+    if (const int code = pcl_ms_tools::loadInitialTriangles(options, cloud, initial, error);
+        code != kSuccess)
+      return fail(code, error);
+
   if (verbose)
     pcl_ms_tools::printReconstructStart(options, parameters);
   pcl::console::TicToc timer;
@@ -93,8 +100,8 @@ int run(int argc, char **argv) {
   pcl_ms::Result result;
   const bool reconstructed =
       parameters.use_normals
-          ? reconstructAs<pcl::PointNormal>(cloud, parameters, polygons, result, error)
-          : reconstructAs<pcl::PointXYZ>(cloud, parameters, polygons, result, error);
+          ? reconstructAs<pcl::PointNormal>(cloud, parameters, initial, polygons, result, error)
+          : reconstructAs<pcl::PointXYZ>(cloud, parameters, initial, polygons, result, error);
   const double reconstruct_ms = timer.toc();
   if (!reconstructed) {
     if (verbose)

@@ -141,6 +141,10 @@ int run(const Job &job, int argc, char **argv) {
                    "with the same triangles as pcl_ms_reconstruct given the same options.");
     return kSuccess;
   }
+  if (!options.initial.empty()) {
+    error = "-initial is not supported across processes: use pcl_ms_reconstruct";
+    return on_rank_zero ? fail(kBadArguments, error) : kBadArguments;
+  }
   pcl_ms::Parameters parameters;
   if (const std::string reason = pcl_ms_tools::reconstructParameters(options, parameters);
       !reason.empty())

@@ -161,10 +161,12 @@ public:
       : scaffold_(scaffold), candidates_(scaffold.candidates), points_(points),
         parameters_(parameters), deadline_(deadline), statistics_(statistics),
         mesh_(scaffold, points.size()), states_(candidates_.size()),
-        is_fixed_(candidates_.size(), false), multi_fan_vertex_(points.size(), false),
-        may_have_several_fans_(points.size(), false) {
+        is_fixed_(candidates_.size(), false), is_preferred_(candidates_.size(), false),
+        multi_fan_vertex_(points.size(), false), may_have_several_fans_(points.size(), false) {
     for (CandidateIndex t : scaffold.fixed)
       is_fixed_[t] = true;
+    for (CandidateIndex t : scaffold.preferred)
+      is_preferred_[t] = !is_fixed_[t];
     delay_multiplier_.resize(2 * static_cast<std::size_t>(parameters.max_delays) + 1);
     for (std::size_t k = 0; k < delay_multiplier_.size(); ++k)
       delay_multiplier_[k] = std::pow(parameters.delay_factor, static_cast<double>(k));
@@ -172,11 +174,13 @@ public:
 
   void run() {
     acceptFixedTriangles();
+    rankPreferredTriangles();
     for (CandidateIndex t = 0; t < candidates_.size(); ++t) {
-      if (is_fixed_[t])
+      if (is_fixed_[t] || states_[t].state != State::idle || mesh_.contains(t))
         continue;
       states_[t].cost = static_cast<float>(freshCost(t));
-      push(t, candidates_[t].type == CandidateType::ambiguous ? State::queue2 : State::queue1);
+      push(t, candidates_[t].type == CandidateType::ambiguous && !is_preferred_[t] ? State::queue2
+                                                                                   : State::queue1);
     }
     runPass(State::queue1, statistics_.pass1);
     removeFlapsAndIsolatedTriangles();
@@ -214,10 +218,59 @@ private:
     }
   }
 
+  /// Preferred triangles (docs/algorithm.md, "Initial triangles") go first,
+  /// alone in Q1, in four rounds: those whose three edges the soup agrees on
+  /// (each shared with exactly one other preferred triangle), then two, one,
+  /// none; within a round by their own costs. A wrong triangle overlapping
+  /// right ones puts a third triangle on their edges, so it comes after them
+  /// and finds its edges full. From then on the base cost of the accepted
+  /// ones is 0: an ordinary candidate undoes one only where its context (how
+  /// sharply it bends against its accepted neighbours) makes it costlier.
+  /// Those not accepted in these rounds are ordinary candidates.
+  void rankPreferredTriangles() {
+    if (scaffold_.preferred.empty())
+      return;
+    // How many preferred triangles each edge has: an edge with exactly two is
+    // one the soup agrees on.
+    std::vector<std::uint8_t> on_edge(scaffold_.numberOfEdges(), 0);
+    for (CandidateIndex t : scaffold_.preferred)
+      if (is_preferred_[t])
+        for (EdgeIndex e : candidates_[t].edges)
+          on_edge[e] = static_cast<std::uint8_t>(std::min(on_edge[e] + 1, 3));
+    std::vector<CandidateIndex> tiers[4];
+    for (CandidateIndex t : scaffold_.preferred) {
+      if (!is_preferred_[t])
+        continue;
+      int agreed = 0;
+      for (EdgeIndex e : candidates_[t].edges)
+        agreed += on_edge[e] == 2;
+      tiers[3 - agreed].push_back(t);
+    }
+    for (const auto &tier : tiers) {
+      for (CandidateIndex t : tier) {
+        states_[t].cost = static_cast<float>(freshCost(t));
+        push(t, State::queue1);
+      }
+      runPass(State::queue1, statistics_.pass1);
+    }
+    preferred_ranked_ = true;
+    for (CandidateIndex t : scaffold_.preferred) {
+      if (states_[t].state != State::accepted) {
+        is_preferred_[t] = false;
+        continue;
+      }
+      states_[t].cost = static_cast<float>(freshCost(t));
+    }
+  }
+
   // ---- costs -------------------------------------------------------------
 
+  double rankingBaseCost(CandidateIndex t) const {
+    return preferred_ranked_ && is_preferred_[t] ? 0.0 : candidates_[t].base_cost;
+  }
+
   double freshCost(CandidateIndex t) const {
-    const double undelayed = std::max(0.0, candidates_[t].base_cost + states_[t].context);
+    const double undelayed = std::max(0.0, rankingBaseCost(t) + states_[t].context);
     return undelayed * delay_multiplier_[states_[t].incidence_delays + states_[t].ranking_delays];
   }
 
@@ -732,7 +785,7 @@ private:
       if (mesh_.edgeTriangleCount(e) != 2)
         continue;
       const auto [first, second] = mesh_.edgeTriangles(e);
-      if (is_fixed_[first] || is_fixed_[second])
+      if (is_fixed_[first] || is_fixed_[second] || is_preferred_[first] || is_preferred_[second])
         continue;
       VertexIndex a = 0, c = 0;
       for (int k = 0; k < 3; ++k)
@@ -821,8 +874,13 @@ private:
       std::size_t best = 0;
       for (std::size_t f = 1; f < fans.size(); ++f) {
         const std::size_t fixed = fixedCount(fans[f]), best_fixed = fixedCount(fans[best]);
+        const std::size_t preferred = preferredCount(fans[f]),
+                          best_preferred = preferredCount(fans[best]);
         if (fixed != best_fixed) {
           if (fixed > best_fixed)
+            best = f;
+        } else if (preferred != best_preferred) {
+          if (preferred > best_preferred)
             best = f;
         } else if (fans[f].size() > fans[best].size() || (fans[f].size() == fans[best].size() &&
                                                           fanCost(fans[f]) < fanCost(fans[best]))) {
@@ -853,6 +911,11 @@ private:
         std::count_if(fan.begin(), fan.end(), [&](CandidateIndex u) { return is_fixed_[u]; }));
   }
 
+  std::size_t preferredCount(const std::vector<CandidateIndex> &fan) const {
+    return static_cast<std::size_t>(
+        std::count_if(fan.begin(), fan.end(), [&](CandidateIndex u) { return is_preferred_[u]; }));
+  }
+
   double fanCost(const std::vector<CandidateIndex> &fan) const {
     double total = 0;
     for (CandidateIndex u : fan)
@@ -878,6 +941,8 @@ private:
   };
   std::vector<CandidateState> states_;
   std::vector<bool> is_fixed_;
+  std::vector<bool> is_preferred_;
+  bool preferred_ranked_ = false; // from then on preferred base costs are 0
   std::vector<bool> multi_fan_vertex_;
   std::vector<bool> may_have_several_fans_;
   std::vector<double> delay_multiplier_;

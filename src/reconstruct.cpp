@@ -48,6 +48,10 @@ std::string Parameters::validate() const {
   else if (!(std::isfinite(time_limit_seconds) && time_limit_seconds >= 0))
     reason << "time limit must be 0 (none) or a number of seconds > 0 (got " << time_limit_seconds
            << ")";
+  else if (initial_triangles_mode != InitialTrianglesMode::fixed &&
+           initial_triangles_mode != InitialTrianglesMode::preferred)
+    reason << "initial triangles mode must be fixed or preferred (got "
+           << static_cast<int>(initial_triangles_mode) << ")";
   else if (grid_buckets < 0 || grid_buckets > max_grid_buckets)
     reason << "grid buckets must be in [0, " << max_grid_buckets << "] (got " << grid_buckets
            << ")";
@@ -223,6 +227,53 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
   return prepared;
 }
 
+/// Preferred initial triangles in distinct-point indices, corners
+/// ascending, each once (docs/algorithm.md, "Initial triangles"): the
+/// repeated ones are merged and those that use an invalid or missing point,
+/// or one point twice, are left out, counted in `result`.
+std::vector<Triangle> preparePreferredTriangles(const std::vector<Triangle> &initial,
+                                                const PreparedPoints &prepared, Result &result) {
+  std::vector<Triangle> mapped;
+  mapped.reserve(initial.size());
+  for (const Triangle &corners : initial) {
+    Triangle triangle;
+    bool valid = true;
+    for (int k = 0; k < 3; ++k) {
+      const VertexIndex record = corners[k];
+      triangle[k] = record < prepared.prepared_of_record.size()
+                        ? prepared.prepared_of_record[record]
+                        : not_prepared;
+      valid = valid && triangle[k] != not_prepared;
+    }
+    std::sort(triangle.begin(), triangle.end());
+    if (!valid || triangle[0] == triangle[1] || triangle[1] == triangle[2]) {
+      ++result.initial_invalid;
+      continue;
+    }
+    mapped.push_back(triangle);
+  }
+  std::sort(mapped.begin(), mapped.end());
+  const auto end = std::unique(mapped.begin(), mapped.end());
+  result.initial_duplicates = static_cast<std::size_t>(mapped.end() - end);
+  mapped.erase(end, mapped.end());
+  return mapped;
+}
+
+/// How many of the distinct initial triangles (distinct-point indices) the
+/// mesh (distinct-point indices) contains.
+std::size_t countKept(std::vector<Triangle> initial, const std::vector<Triangle> &mesh) {
+  for (Triangle &triangle : initial)
+    std::sort(triangle.begin(), triangle.end());
+  std::sort(initial.begin(), initial.end());
+  initial.erase(std::unique(initial.begin(), initial.end()), initial.end());
+  std::size_t kept = 0;
+  for (Triangle triangle : mesh) {
+    std::sort(triangle.begin(), triangle.end());
+    kept += std::binary_search(initial.begin(), initial.end(), triangle);
+  }
+  return kept;
+}
+
 /// The user's initial triangles in distinct-point indices. Each must use
 /// three distinct input points, appear once, and share each edge with at
 /// most one other: the greedy builds a 2-manifold around them.
@@ -305,14 +356,21 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
   result.timings.prepare = secondsSince(stage);
   result.peak_memory.prepare = peakResidentBytes();
 
-  const std::vector<Triangle> fixed = prepareInitialTriangles(initial_triangles, prepared);
+  const bool preferred_mode = parameters.initial_triangles_mode == InitialTrianglesMode::preferred;
+  const std::vector<Triangle> fixed = preferred_mode
+                                          ? std::vector<Triangle>()
+                                          : prepareInitialTriangles(initial_triangles, prepared);
+  const std::vector<Triangle> preferred =
+      preferred_mode ? preparePreferredTriangles(initial_triangles, prepared, result)
+                     : std::vector<Triangle>();
   const std::vector<Eigen::Vector3f> *normals =
       parameters.use_normals ? &prepared.normals : nullptr;
 
   std::vector<Triangle> triangles;
   std::vector<float> local_scale; // per distinct point
   // Initial triangles are honoured by the one-piece path only.
-  const bool in_buckets = fixed.empty() && usesBuckets(prepared.positions.size(), parameters);
+  const bool in_buckets =
+      initial_triangles.empty() && usesBuckets(prepared.positions.size(), parameters);
   // Only process 0 meshes a one-piece cloud and finishes the surface.
   const bool gathers = exchange.process() == 0;
   if (!in_buckets && !gathers)
@@ -343,6 +401,7 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
     options.normals = normals;
     options.normal_weight = parameters.normal_weight;
     options.fixed_triangles = fixed.empty() ? nullptr : &fixed;
+    options.preferred_triangles = preferred.empty() ? nullptr : &preferred;
     deadline.check("the preparation");
     MedialScaffold scaffold = buildMedialScaffold(prepared.positions, options);
     deadline.check("the scaffold");
@@ -355,6 +414,8 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
     result.candidates_type2 = scaffold.type2;
     result.candidates_type3 = scaffold.type3;
     result.candidates_oversize = scaffold.oversize;
+    result.initial_oversize = scaffold.preferred_oversize;
+    result.initial_invalid += scaffold.preferred_degenerate;
     result.peak_memory.scaffold = std::max(result.peak_memory.prepare, peakResidentBytes());
 
     stage = Clock::now();
@@ -372,7 +433,10 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
 
   deadline.check("the greedy passes");
   stage = Clock::now();
-  // The user's initial triangles must survive the twist repair.
+  // The user's fixed triangles must survive the twist repair. Preferred ones
+  // are not protected: anchoring their corners kept 3 more of them on the
+  // bunny soup of tests/test_soup.cpp and left 5 more loops open; sparing
+  // just them kept 14 more on CGAL's cow soup but left the cow one-sided.
   std::vector<bool> anchored;
   if (!fixed.empty()) {
     anchored.assign(prepared.positions.size(), false);
@@ -394,6 +458,8 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
                       anchored.empty() ? nullptr : &anchored, viewpoint ? &*viewpoint : nullptr);
   });
   deadline.check("the finish");
+  if (!fixed.empty() || !preferred.empty())
+    result.initial_kept = countKept(fixed.empty() ? preferred : fixed, surface.triangles);
   // Back to the user's records.
   for (Triangle &triangle : surface.triangles)
     for (VertexIndex &v : triangle)

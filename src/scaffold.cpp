@@ -211,6 +211,8 @@ public:
     delaunay.clear();
     if (options_.fixed_triangles)
       addFixedTriangles(*options_.fixed_triangles);
+    if (options_.preferred_triangles)
+      addPreferredTriangles(*options_.preferred_triangles);
     buildEdgeGraph();
     return std::move(scaffold_);
   }
@@ -612,6 +614,56 @@ private:
 
   static constexpr CandidateIndex no_fixed_candidate = std::numeric_limits<CandidateIndex>::max();
 
+  /// Finds each preferred triangle (distinct, corners ascending) among the
+  /// candidates and appends the missing ones that are neither oversize nor
+  /// degenerate (docs/algorithm.md, "Initial triangles"). An appended one is
+  /// costed like a type III candidate, with the local scale for R: the
+  /// greedy ranks the preferred ones by that cost among themselves.
+  void addPreferredTriangles(const std::vector<Triangle> &preferred) {
+    std::vector<Triangle> sorted = preferred;
+    std::sort(sorted.begin(), sorted.end());
+    std::vector<bool> found(sorted.size(), false);
+    for (CandidateIndex t = 0; t < scaffold_.candidates.size(); ++t) {
+      const auto it =
+          std::lower_bound(sorted.begin(), sorted.end(), scaffold_.candidates[t].vertices);
+      if (it != sorted.end() && *it == scaffold_.candidates[t].vertices) {
+        found[static_cast<std::size_t>(it - sorted.begin())] = true;
+        scaffold_.preferred.push_back(t);
+      }
+    }
+    const std::vector<float> &scale = scaffold_.local_scale;
+    for (std::size_t i = 0; i < sorted.size(); ++i) {
+      if (found[i])
+        continue;
+      const Triangle &vertices = sorted[i];
+      const Eigen::Vector3d &a = points_[vertices[0]], &b = points_[vertices[1]],
+                            &c = points_[vertices[2]];
+      const double local_scale = triangleScale(scale, vertices);
+      const TriangleShape shape = triangleShape(a, b, c);
+      if (shape.longest_side >= options_.rho * local_scale) {
+        ++scaffold_.preferred_oversize;
+        continue;
+      }
+      if (CGAL::collinear(KernelPoint(a.x(), a.y(), a.z()), KernelPoint(b.x(), b.y(), b.z()),
+                          KernelPoint(c.x(), c.y(), c.z())) ||
+          !(shape.compactness > 0)) {
+        ++scaffold_.preferred_degenerate;
+        continue;
+      }
+      Candidate candidate;
+      candidate.vertices = vertices;
+      candidate.edges = {0, 0, 0};
+      const double compactness_squared = shape.compactness * shape.compactness;
+      candidate.base_cost =
+          static_cast<float>(baseCost(shape.perimeter, local_scale, shape.compactness));
+      candidate.inverse_shock_compactness =
+          static_cast<float>(1.0 / (local_scale * compactness_squared));
+      candidate.type = CandidateType::acute;
+      scaffold_.preferred.push_back(static_cast<CandidateIndex>(scaffold_.candidates.size()));
+      scaffold_.candidates.push_back(candidate);
+    }
+  }
+
   /// Numbers the edges of the candidates pass 1 looks at (types I and II,
   /// fixed ones) and lists those candidates on each edge. The other type III
   /// candidates keep no_edge: numbering and listing them would cost most of
@@ -622,8 +674,11 @@ private:
     std::vector<bool> in_graph(candidates.size());
     for (CandidateIndex t = 0; t < candidates.size(); ++t)
       in_graph[t] = candidates[t].type != CandidateType::ambiguous;
-    // Fixed triangles are in the mesh from the start, whatever their type.
+    // Fixed triangles are in the mesh from the start, whatever their type;
+    // preferred ones are ranked in pass 1.
     for (CandidateIndex t : scaffold_.fixed)
+      in_graph[t] = true;
+    for (CandidateIndex t : scaffold_.preferred)
       in_graph[t] = true;
     for (CandidateIndex t = 0; t < candidates.size(); ++t)
       if (!in_graph[t])

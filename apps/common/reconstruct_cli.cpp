@@ -11,10 +11,14 @@
 #include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
+#include <pcl/conversions.h>
+#include <pcl/point_types.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <filesystem>
+#include <unordered_map>
 #include <utility>
 
 #include <unistd.h>
@@ -93,6 +97,12 @@ void printReconstructHelp(const char *program, const char *summary) {
   print_info("  -no_viewpoint   no viewpoint, even for an organized cloud\n");
   print_info("  -time_limit S   give up after S seconds with an error and no output file,\n"
              "                  0 = no limit (default 0)\n");
+  print_info("  -initial MESH   a partial mesh or polygon soup (.ply, .obj, .off or .vtk) whose\n"
+             "                  vertices are input points: its triangles start the surface\n");
+  print_info("  -initial_mode fixed|preferred  fixed (default): the initial triangles stay and\n"
+             "                  must be edge-manifold; preferred: they are accepted first but\n"
+             "                  undone where they conflict, so a soup with wrong, overlapping\n"
+             "                  or repeated triangles gives a manifold mesh\n");
   print_info("  -keep_layout    write every point of the cloud, in its order and organized\n"
              "                  layout, points without a position (NaN) too (default: those\n"
              "                  are left out of the file, which mesh viewers cannot read)\n");
@@ -104,8 +114,8 @@ void printReconstructHelp(const char *program, const char *summary) {
 bool parseReconstructArguments(int argc, char **argv, ReconstructOptions &options,
                                std::string &error) {
   const std::vector<std::string> value_options = {
-      "-rho",  "-fill_holes", "-threads",    "-bucket_points",
-      "-grid", "-viewpoint",  "-time_limit", "-estimate_normals"};
+      "-rho",       "-fill_holes", "-threads",          "-bucket_points", "-grid",
+      "-viewpoint", "-time_limit", "-estimate_normals", "-initial",       "-initial_mode"};
   std::vector<std::string> positional;
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
@@ -168,6 +178,22 @@ bool parseReconstructArguments(int argc, char **argv, ReconstructOptions &option
     error = "-normals and -estimate_normals exclude each other";
     return false;
   }
+  pcl::console::parse_argument(argc, argv, "-initial", options.initial);
+  if (const int index = pcl::console::find_argument(argc, argv, "-initial_mode"); index >= 0) {
+    const std::string mode = argv[index + 1];
+    if (mode == "fixed")
+      options.initial_mode = pcl_ms::InitialTrianglesMode::fixed;
+    else if (mode == "preferred")
+      options.initial_mode = pcl_ms::InitialTrianglesMode::preferred;
+    else {
+      error = "-initial_mode: '" + mode + "' is not fixed or preferred";
+      return false;
+    }
+    if (options.initial.empty()) {
+      error = "-initial_mode needs -initial MESH";
+      return false;
+    }
+  }
 
   if (positional.size() != 2) {
     error = "expected input and output file names, got " + std::to_string(positional.size()) +
@@ -190,6 +216,7 @@ std::string reconstructParameters(const ReconstructOptions &options,
   if (!options.viewpoint.empty())
     parameters.viewpoint = {{options.viewpoint[0], options.viewpoint[1], options.viewpoint[2]}};
   parameters.time_limit_seconds = options.time_limit;
+  parameters.initial_triangles_mode = options.initial_mode;
   return parameters.validate();
 }
 
@@ -249,6 +276,75 @@ int loadReconstructInput(const ReconstructOptions &options, pcl_ms::Parameters &
   return kSuccess;
 }
 
+int loadInitialTriangles(const ReconstructOptions &options, const pcl::PCLPointCloud2 &cloud,
+                         std::vector<pcl::Vertices> &triangles, std::string &error) {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<pcl_ms::Triangle> mesh_triangles;
+  double load_ms = 0;
+  if (!fileStep("Loading", options.initial, !options.quiet, load_ms, [&] {
+        return pcl_ms::loadMesh(options.initial, vertices, mesh_triangles, error);
+      })) {
+    error = "-initial: " + error;
+    return kIoFailure;
+  }
+  pcl::PointCloud<pcl::PointXYZ> points;
+  pcl::fromPCLPointCloud2(cloud, points);
+  // Input point of each position; the first of repeated ones.
+  struct PositionHash {
+    std::size_t operator()(const std::array<float, 3> &p) const {
+      std::size_t hash = 0;
+      for (float value : p)
+        hash = hash * 1000003u ^ std::hash<float>()(value);
+      return hash;
+    }
+  };
+  std::unordered_map<std::array<float, 3>, pcl::index_t, PositionHash> point_at;
+  point_at.reserve(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    point_at.emplace(std::array<float, 3>{points[i].x, points[i].y, points[i].z},
+                     static_cast<pcl::index_t>(i));
+  std::vector<pcl::index_t> point_of_vertex(vertices.size(), -1);
+  std::size_t unmatched = 0;
+  for (std::size_t v = 0; v < vertices.size(); ++v) {
+    const std::array<float, 3> position = {static_cast<float>(vertices[v].x()),
+                                           static_cast<float>(vertices[v].y()),
+                                           static_cast<float>(vertices[v].z())};
+    const auto found = point_at.find(position);
+    if (found != point_at.end())
+      point_of_vertex[v] = found->second;
+    else
+      ++unmatched;
+  }
+  triangles.clear();
+  triangles.reserve(mesh_triangles.size());
+  for (std::size_t t = 0; t < mesh_triangles.size(); ++t) {
+    pcl::Vertices polygon;
+    for (pcl_ms::VertexIndex v : mesh_triangles[t]) {
+      if (point_of_vertex[v] < 0 && options.initial_mode == pcl_ms::InitialTrianglesMode::fixed) {
+        error = "-initial: vertex " + std::to_string(v) + " of triangle " + std::to_string(t) +
+                " of " + options.initial + " is not a point of " + options.input;
+        return kBadArguments;
+      }
+      polygon.vertices.push_back(point_of_vertex[v]); // -1: left out in preferred mode
+    }
+    triangles.push_back(std::move(polygon));
+  }
+  if (!options.quiet) {
+    print_info("[done, ");
+    print_value("%.1f", load_ms);
+    print_info(" ms : ");
+    print_value("%zu", triangles.size());
+    print_info(" triangles");
+    if (unmatched > 0) {
+      print_info(", ");
+      print_value("%zu", unmatched);
+      print_info(" vertices not in the input");
+    }
+    print_info("]\n");
+  }
+  return kSuccess;
+}
+
 void printReconstructStart(const ReconstructOptions &options,
                            const pcl_ms::Parameters &parameters) {
   print_highlight("Reconstructing with rho ");
@@ -262,6 +358,11 @@ void printReconstructStart(const ReconstructOptions &options,
     print_value("%s", options.normals ? "on" : "off");
   print_info(", threads ");
   print_value("%d", options.threads);
+  if (!options.initial.empty()) {
+    print_info(", initial triangles ");
+    print_value("%s", options.initial_mode == pcl_ms::InitialTrianglesMode::preferred ? "preferred"
+                                                                                      : "fixed");
+  }
   if (parameters.viewpoint) {
     print_info(", viewpoint ");
     print_value("%g,%g,%g%s", (*parameters.viewpoint)[0], (*parameters.viewpoint)[1],
@@ -319,6 +420,14 @@ void printReconstructReport(const pcl_ms::Result &result, double load_ms, double
   printRow("boundary loops", "%10.0f", static_cast<double>(result.boundary_loops.size()));
   printRow("holes filled", "%10.0f", static_cast<double>(result.holes_filled));
   printRow("fold triangles cut", "%10.0f", static_cast<double>(result.twist_triangles_removed));
+  if (result.initial_kept + result.initial_duplicates + result.initial_invalid +
+          result.initial_oversize >
+      0) {
+    printRow("initial triangles kept", "%10.0f", static_cast<double>(result.initial_kept));
+    printRow("initial repeats merged", "%10.0f", static_cast<double>(result.initial_duplicates));
+    printRow("initial invalid", "%10.0f", static_cast<double>(result.initial_invalid));
+    printRow("initial oversize", "%10.0f", static_cast<double>(result.initial_oversize));
+  }
   print_info("  %-22s", "components");
   print_value("%10zu", result.numberOfComponents());
   print_info(" (");

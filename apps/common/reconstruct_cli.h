@@ -30,6 +30,8 @@ struct ReconstructOptions {
   std::vector<double> viewpoint; // empty, or x, y, z
   bool no_viewpoint = false;
   double time_limit = 0; // seconds, 0: none
+  std::string initial;   // a mesh whose triangles start the surface, or empty
+  pcl_ms::InitialTrianglesMode initial_mode = pcl_ms::InitialTrianglesMode::fixed;
   bool quiet = false;
   bool keep_layout = false; // write the cloud's points as they are, NaN rows too
   bool help = false;
@@ -55,6 +57,14 @@ int checkMeshOutput(const std::string &output, std::string &error);
 /// file's viewpoint rule; kSuccess or an exit code with `error` set.
 int loadReconstructInput(const ReconstructOptions &options, pcl_ms::Parameters &parameters,
                          pcl::PCLPointCloud2 &cloud, double &load_ms, std::string &error);
+
+/// Reads the triangles of options.initial as indices into `cloud`: each
+/// mesh vertex is the input point at the same position (the first, if
+/// several are). In preferred mode a triangle with a vertex that is no input
+/// point gets an invalid index (the library leaves it out and counts it);
+/// in fixed mode that is an error. kSuccess or an exit code with `error` set.
+int loadInitialTriangles(const ReconstructOptions &options, const pcl::PCLPointCloud2 &cloud,
+                         std::vector<pcl::Vertices> &triangles, std::string &error);
 
 /// Prints the "Reconstructing with ..." line.
 void printReconstructStart(const ReconstructOptions &options, const pcl_ms::Parameters &parameters);

@@ -36,6 +36,7 @@ public:
   using Ptr = shared_ptr<MedialScaffoldReconstruction<PointInT>>;
   using ConstPtr = shared_ptr<const MedialScaffoldReconstruction<PointInT>>;
   using NormalCloud = pcl::PointCloud<pcl::Normal>;
+  using InitialTrianglesMode = pcl_ms::InitialTrianglesMode;
 
   using SurfaceReconstruction<PointInT>::reconstruct;
 
@@ -134,13 +135,28 @@ public:
   void setTimeLimit(double seconds) { parameters_.time_limit_seconds = seconds; }
   double getTimeLimit() const { return parameters_.time_limit_seconds; }
 
-  /** \brief Triangles (indices into the input cloud) that are part of the
-   * surface from the start; the method completes the mesh around them
-   * (default: none). They must be edge-manifold and use valid points. */
+  /** \brief Triangles (indices into the input cloud) of a partial mesh or
+   * polygon soup; the method completes the mesh around them (default: none).
+   * See setInitialTrianglesMode() for how they are treated. */
   void setInitialTriangles(const std::vector<pcl::Vertices> &triangles) {
     initial_triangles_ = triangles;
   }
   const std::vector<pcl::Vertices> &getInitialTriangles() const { return initial_triangles_; }
+
+  /** \brief InitialTrianglesMode::fixed (default): the initial triangles stay
+   * whatever happens; they must be edge-manifold triangles of valid points,
+   * or reconstruct() fails with the reason. InitialTrianglesMode::preferred:
+   * they are accepted first but undone like any other candidate where they
+   * conflict, so that a soup with wrong, overlapping or repeated triangles
+   * gives a manifold mesh; repeated ones are merged, and invalid polygons
+   * (not 3 vertices, an invalid point) and oversize ones are left out and
+   * counted in getResult(). */
+  void setInitialTrianglesMode(InitialTrianglesMode mode) {
+    parameters_.initial_triangles_mode = mode;
+  }
+  InitialTrianglesMode getInitialTrianglesMode() const {
+    return parameters_.initial_triangles_mode;
+  }
 
   /** \brief All parameters at once (core struct). */
   void setParameters(const pcl_ms::Parameters &parameters) { parameters_ = parameters; }

@@ -48,9 +48,9 @@ constexpr EdgeIndex no_edge = std::numeric_limits<EdgeIndex>::max();
 struct MedialScaffold {
   std::vector<Candidate> candidates;
   /// The edge graph holds the candidates pass 1 looks at: types I and II and
-  /// the fixed ones, ascending on each edge. The other type III candidates,
-  /// the majority but rarely kept, wait outside it with edges no_edge:
-  /// GreedyMesher numbers those that reach pass 2.
+  /// the fixed and preferred ones, ascending on each edge. The other type III
+  /// candidates, the majority but rarely kept, wait outside it with edges
+  /// no_edge: GreedyMesher numbers those that reach pass 2.
   std::vector<std::uint32_t> edge_offsets; // edges + 1 entries
   std::vector<CandidateIndex> edge_candidates;
   /// Edge ids by end points: edge_vertex_offsets[a] is the id of a's first
@@ -60,6 +60,10 @@ struct MedialScaffold {
   std::vector<VertexIndex> edge_high_vertices;
   /// The candidates of ScaffoldOptions::fixed_triangles, in the same order.
   std::vector<CandidateIndex> fixed;
+  /// The candidates of ScaffoldOptions::preferred_triangles that were kept,
+  /// each once, and how many were left out as oversize or degenerate.
+  std::vector<CandidateIndex> preferred;
+  std::size_t preferred_oversize = 0, preferred_degenerate = 0;
 
   /// Each point's local scale: the median circumradius of the type I and
   /// II triangles at it. A candidate's sides stay below rho times
@@ -112,6 +116,12 @@ struct ScaffoldOptions {
   /// becomes a candidate even when it is not a Delaunay triangle of these
   /// points or is longer than d_max; the greedy keeps them all.
   const std::vector<Triangle> *fixed_triangles = nullptr;
+  /// Triangles the greedy accepts first but may undo (preferred mode of the
+  /// initial triangles; distinct, corners ascending). Each becomes a
+  /// candidate even when it is not a Delaunay triangle, unless it is oversize
+  /// (a side reaching rho times its local scale) or degenerate: those are
+  /// left out and counted.
+  const std::vector<Triangle> *preferred_triangles = nullptr;
   /// Vertices that only fixed triangles may use (one flag per point).
   const std::vector<bool> *frozen_vertices = nullptr;
 };

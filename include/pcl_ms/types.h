@@ -30,6 +30,17 @@ struct PointView {
   const std::vector<int> *indices = nullptr;
 };
 
+/// How reconstruct() treats the initial triangles of a partial mesh or
+/// polygon soup (docs/algorithm.md, "Initial triangles").
+enum class InitialTrianglesMode : std::uint8_t {
+  /// In the surface from the start and never undone; input that is not an
+  /// edge-manifold set of valid triangles is rejected with the reason.
+  fixed,
+  /// Accepted first, cost 0, but undone like any other candidate when they
+  /// conflict; duplicates are merged, invalid and oversize ones left out.
+  preferred
+};
+
 /// All tuning knobs of the method (docs/algorithm.md).
 struct Parameters {
   /// Candidates with a side >= rho times their local scale (the typical
@@ -75,6 +86,8 @@ struct Parameters {
   /// Called with (units done, units in all) as buckets and seams finish,
   /// from worker threads one call at a time.
   std::function<void(std::size_t, std::size_t)> progress;
+  /// How initial triangles given to reconstruct() are treated (default fixed).
+  InitialTrianglesMode initial_triangles_mode = InitialTrianglesMode::fixed;
 
   /// Empty when valid, else a one-line reason.
   std::string validate() const;
@@ -157,6 +170,13 @@ struct Result {
   /// Triangles cut out where the surface folded or twisted (the finish's
   /// twist repair; docs/algorithm.md, "Finishing").
   std::size_t twist_triangles_removed = 0;
+  /// Initial triangles (preferred mode) left out before meshing: listed
+  /// again (any corner order; merged), invalid (a point that is not a valid
+  /// input point, two corners at one position, or all three on a line), or
+  /// oversize (a side reaching rho times the local scale).
+  std::size_t initial_duplicates = 0, initial_invalid = 0, initial_oversize = 0;
+  /// Distinct initial triangles that are in the output mesh (either mode).
+  std::size_t initial_kept = 0;
   BucketStatistics bucket_statistics;
   StageTimings timings;
   StagePeakMemory peak_memory;

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <exception>
+#include <limits>
 #include <new>
 #include <string>
 
@@ -91,10 +92,18 @@ bool MedialScaffoldReconstruction<PointInT>::runCore(std::vector<pcl::Vertices> 
 
   std::vector<pcl_ms::Triangle> initial;
   initial.reserve(initial_triangles_.size());
+  const bool preferred =
+      parameters_.initial_triangles_mode == pcl_ms::InitialTrianglesMode::preferred;
   for (std::size_t t = 0; t < initial_triangles_.size(); ++t) {
     const auto &vertices = initial_triangles_[t].vertices;
     const bool negative =
         std::any_of(vertices.begin(), vertices.end(), [](pcl::index_t v) { return v < 0; });
+    if ((vertices.size() != 3 || negative) && preferred) {
+      // No valid point: the core leaves it out and counts it.
+      constexpr auto invalid = std::numeric_limits<pcl_ms::VertexIndex>::max();
+      initial.push_back({invalid, invalid, invalid});
+      continue;
+    }
     if (vertices.size() != 3 || negative) {
       error_message_ = "initial polygon " + std::to_string(t) +
                        (negative ? " has a negative index"
