@@ -28,7 +28,8 @@ struct ReconstructOptions {
   int grid = 0;
   std::vector<double> viewpoint; // empty, or x, y, z
   bool no_viewpoint = false;
-  double time_limit = 0; // seconds, 0: none
+  double time_limit = 0;   // seconds, 0: none
+  std::string medial_axis; // .ply for the medial axis; empty: not computed
   bool quiet = false;
   bool help = false;
 };
@@ -48,6 +49,14 @@ std::string reconstructParameters(const ReconstructOptions &options,
 /// kSuccess, or the exit code for an output path that cannot be written
 /// (checked before spending time on the reconstruction), with `error` set.
 int checkMeshOutput(const std::string &output, std::string &error);
+
+/// As checkMeshOutput, for the -medial_axis file (kSuccess when none).
+int checkMedialAxisOutput(const std::string &path, std::string &error);
+
+/// Saves the result's medial axis to options.medial_axis with the "Saving"
+/// line; kSuccess (also when none was asked for) or kIoFailure.
+int saveReconstructedMedialAxis(const ReconstructOptions &options, const pcl_ms::Result &result,
+                                std::string &error);
 
 /// Loads the input, prints the PCL-style "Loading" line and applies the
 /// file's viewpoint rule; kSuccess or an exit code with `error` set.

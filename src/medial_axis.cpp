@@ -1,0 +1,441 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The medial axis left by the surface: poles of the Voronoi diagram as A1^4
+// nodes, the Voronoi edges between them as A1^3 curves, and each node's side
+// of the closed components (docs/algorithm.md, "Medial axis output").
+#include <pcl_ms/medial_axis.h>
+#include <pcl_ms/reconstruct.h>
+
+#include "flat_cells.h"
+
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Delaunay_triangulation_cell_base_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_cell_base_with_info_3.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <numeric>
+#include <string>
+#include <tuple>
+
+namespace pcl_ms {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using KernelPoint = Kernel::Point_3;
+using VertexBase = CGAL::Triangulation_vertex_base_with_info_3<VertexIndex, Kernel>;
+using CellBase =
+    CGAL::Triangulation_cell_base_with_info_3<std::uint32_t, Kernel,
+                                              CGAL::Delaunay_triangulation_cell_base_3<Kernel>>;
+using DataStructure = CGAL::Triangulation_data_structure_3<VertexBase, CellBase>;
+using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, DataStructure>;
+using CellHandle = Delaunay::Cell_handle;
+using VertexHandle = Delaunay::Vertex_handle;
+
+constexpr std::uint32_t no_cell = std::numeric_limits<std::uint32_t>::max();
+
+// A pole is a node only when two of its ball's contact points (the
+// tetrahedron's corners) are at least this angle apart as seen from its
+// centre (the theta filter of Foskey, Lin and Manocha's simplified medial
+// axis). Balls whose four contacts crowd into a small cap of the surface are
+// flat tetrahedra hugging it: nearly on one circle, so the sample hardly
+// fixes where along the surface normal their centre lies (on a sampled unit
+// sphere such poles were up to 0.07 off the centre with 5,000 points and 0.37
+// with 20,000; the wide ones less than 1e-6).
+// 45 degrees keeps the medial sheets of ridges up to 135 degrees sharp.
+constexpr double min_contact_angle = M_PI / 4;
+
+bool lessPoint(const Eigen::Vector3d &a, const Eigen::Vector3d &b) {
+  return std::tie(a.x(), a.y(), a.z()) < std::tie(b.x(), b.y(), b.z());
+}
+
+Eigen::Vector3d toEigen(const KernelPoint &p) { return {p.x(), p.y(), p.z()}; }
+
+/// A triangle's corners in ascending order: the key of a Delaunay facet.
+Triangle sortedTriangle(VertexIndex a, VertexIndex b, VertexIndex c) {
+  Triangle triangle{a, b, c};
+  std::sort(triangle.begin(), triangle.end());
+  return triangle;
+}
+
+/// Per finite cell: its circumcentre and radius, computed from the corners
+/// in coordinate order so that the figures do not depend on how CGAL
+/// happens to order them (that follows the insertion order).
+struct CellBall {
+  std::array<VertexIndex, 4> corners; // ascending by coordinates
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  double radius = 0;
+  bool valid = false; // false: no circumcentre in double (flat_cells.h)
+  /// Whether two corners subtend at least min_contact_angle at the centre.
+  bool wide = false;
+};
+
+/// What the surface says about each point and Delaunay facet.
+struct SurfaceFacets {
+  /// Per cell, bit i set when its facet i (opposite corner i) is a surface
+  /// triangle; and when that triangle is a wall: part of a closed component
+  /// whose triangles are all Delaunay facets, which separates inside from
+  /// outside.
+  std::vector<std::uint8_t> in_surface, wall;
+  /// Points on a component with a boundary (or one that cannot serve as a
+  /// wall): cells touching them get no side.
+  std::vector<bool> on_open_part;
+};
+
+class MedialAxisBuilder {
+public:
+  explicit MedialAxisBuilder(const std::vector<Eigen::Vector3d> &points) : points_(points) {}
+
+  MedialAxis build(const std::vector<Triangle> &surface) {
+    MedialAxis axis;
+    findDistinctPoints();
+    if (distinct_.size() < 4)
+      return axis;
+    triangulate();
+    if (delaunay_.dimension() < 3)
+      return axis;
+    collectCells();
+    const SurfaceFacets facets = classifySurface(surface);
+    const std::vector<std::uint8_t> side = cellSides(facets);
+    const std::vector<bool> is_pole = findPoles();
+
+    // Nodes in the order of their corners' coordinates.
+    std::vector<std::uint32_t> pole_cells;
+    for (std::uint32_t c = 0; c < cells_.size(); ++c)
+      if (is_pole[c] && balls_[c].wide)
+        pole_cells.push_back(c);
+    std::sort(pole_cells.begin(), pole_cells.end(), [&](std::uint32_t a, std::uint32_t b) {
+      return std::lexicographical_compare(
+          balls_[a].corners.begin(), balls_[a].corners.end(), balls_[b].corners.begin(),
+          balls_[b].corners.end(),
+          [&](VertexIndex p, VertexIndex q) { return rank_[p] < rank_[q]; });
+    });
+    std::vector<std::uint32_t> node_of_cell(cells_.size(), no_cell);
+    for (std::uint32_t n = 0; n < pole_cells.size(); ++n) {
+      const CellBall &ball = balls_[pole_cells[n]];
+      node_of_cell[pole_cells[n]] = n;
+      axis.node_positions.push_back(ball.centre);
+      axis.node_radii.push_back(ball.radius);
+      axis.node_side.push_back(side[pole_cells[n]]);
+    }
+
+    // Curves: Voronoi edges between two nodes across a facet the surface
+    // did not take.
+    for (std::uint32_t c = 0; c < cells_.size(); ++c) {
+      if (node_of_cell[c] == no_cell)
+        continue;
+      for (int i = 0; i < 4; ++i) {
+        const CellHandle neighbour = cells_[c]->neighbor(i);
+        if (delaunay_.is_infinite(neighbour))
+          continue;
+        const std::uint32_t other = neighbour->info();
+        if (other < c || node_of_cell[other] == no_cell)
+          continue; // each facet once, from its lower-numbered cell
+        if (facets.in_surface[c] & (1u << i))
+          continue;
+        const std::uint32_t a = node_of_cell[c], b = node_of_cell[other];
+        axis.curves.push_back({std::min(a, b), std::max(a, b)});
+      }
+    }
+    std::sort(axis.curves.begin(), axis.curves.end());
+    return axis;
+  }
+
+private:
+  /// Exact duplicates stand for the first of them in coordinate order.
+  void findDistinctPoints() {
+    std::vector<VertexIndex> order(points_.size());
+    std::iota(order.begin(), order.end(), VertexIndex(0));
+    std::sort(order.begin(), order.end(), [&](VertexIndex a, VertexIndex b) {
+      return lessPoint(points_[a], points_[b]) || (!lessPoint(points_[b], points_[a]) && a < b);
+    });
+    representative_.assign(points_.size(), 0);
+    rank_.assign(points_.size(), 0);
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      if (k > 0 && points_[order[k]] == points_[order[k - 1]]) {
+        representative_[order[k]] = representative_[order[k - 1]];
+        continue;
+      }
+      representative_[order[k]] = order[k];
+      rank_[order[k]] = static_cast<VertexIndex>(distinct_.size());
+      distinct_.push_back(order[k]);
+    }
+  }
+
+  void triangulate() {
+    std::vector<std::pair<KernelPoint, VertexIndex>> input;
+    input.reserve(distinct_.size());
+    for (VertexIndex p : distinct_)
+      input.emplace_back(KernelPoint(points_[p].x(), points_[p].y(), points_[p].z()), p);
+    // The points go in in coordinate order and CGAL's symbolic perturbation
+    // is by coordinates too: the same point set gives the same tetrahedra.
+    delaunay_.insert(input.begin(), input.end());
+    vertex_of_point_.assign(points_.size(), VertexHandle());
+    for (VertexHandle vertex : delaunay_.finite_vertex_handles())
+      vertex_of_point_[vertex->info()] = vertex;
+  }
+
+  void collectCells() {
+    std::uint32_t id = 0;
+    for (CellHandle cell : delaunay_.all_cell_handles()) {
+      cell->info() = id++;
+      cells_.push_back(cell);
+    }
+    balls_.resize(cells_.size());
+    for (std::uint32_t c = 0; c < cells_.size(); ++c) {
+      const CellHandle cell = cells_[c];
+      if (delaunay_.is_infinite(cell) || detail::hasNoCircumcentre(cell))
+        continue;
+      CellBall &ball = balls_[c];
+      for (int k = 0; k < 4; ++k)
+        ball.corners[k] = cell->vertex(k)->info();
+      std::sort(ball.corners.begin(), ball.corners.end(),
+                [&](VertexIndex p, VertexIndex q) { return rank_[p] < rank_[q]; });
+      const KernelPoint centre = CGAL::circumcenter(
+          vertex_of_point_[ball.corners[0]]->point(), vertex_of_point_[ball.corners[1]]->point(),
+          vertex_of_point_[ball.corners[2]]->point(), vertex_of_point_[ball.corners[3]]->point());
+      ball.centre = toEigen(centre);
+      ball.radius = (ball.centre - points_[ball.corners[0]]).norm();
+      double longest = 0;
+      for (int a = 0; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b)
+          longest = std::max(longest, (points_[ball.corners[a]] - points_[ball.corners[b]]).norm());
+      ball.valid = std::isfinite(ball.radius);
+      ball.wide = longest >= 2 * ball.radius * std::sin(min_contact_angle / 2);
+    }
+  }
+
+  /// Surface triangles in distinct points; which components are closed (no
+  /// edge used once) and so can wall off an inside.
+  SurfaceFacets classifySurface(const std::vector<Triangle> &surface) const {
+    SurfaceFacets facets;
+    facets.on_open_part.assign(points_.size(), false);
+    std::vector<Triangle> triangles;
+    triangles.reserve(surface.size());
+    for (const Triangle &t : surface) {
+      const Triangle key =
+          sortedTriangle(representative_[t[0]], representative_[t[1]], representative_[t[2]]);
+      if (key[0] != key[1] && key[1] != key[2])
+        triangles.push_back(key);
+    }
+    std::sort(triangles.begin(), triangles.end());
+    triangles.erase(std::unique(triangles.begin(), triangles.end()), triangles.end());
+
+    // Components by shared edges (union-find over triangles).
+    std::vector<std::uint32_t> parent(triangles.size());
+    std::iota(parent.begin(), parent.end(), 0u);
+    const auto root = [&](std::uint32_t t) {
+      while (parent[t] != t)
+        t = parent[t] = parent[parent[t]];
+      return t;
+    };
+    struct EdgeUse {
+      VertexIndex a, b;
+      std::uint32_t triangle;
+      bool operator<(const EdgeUse &other) const {
+        return std::tie(a, b, triangle) < std::tie(other.a, other.b, other.triangle);
+      }
+    };
+    std::vector<EdgeUse> edges;
+    edges.reserve(3 * triangles.size());
+    for (std::uint32_t t = 0; t < triangles.size(); ++t) {
+      const Triangle &k = triangles[t];
+      edges.push_back({k[0], k[1], t});
+      edges.push_back({k[1], k[2], t});
+      edges.push_back({k[0], k[2], t});
+    }
+    std::sort(edges.begin(), edges.end());
+    std::vector<bool> touches_boundary(triangles.size(), false);
+    for (std::size_t first = 0; first < edges.size();) {
+      std::size_t last = first + 1;
+      while (last < edges.size() && edges[last].a == edges[first].a &&
+             edges[last].b == edges[first].b)
+        ++last;
+      if (last - first == 1)
+        touches_boundary[edges[first].triangle] = true;
+      for (std::size_t e = first + 1; e < last; ++e)
+        parent[root(edges[e].triangle)] = root(edges[first].triangle);
+      first = last;
+    }
+    // A component is open when one of its edges is a boundary edge, or when
+    // one of its triangles is not a Delaunay facet (a hole filled across
+    // other triangles): the flood below could leak past it.
+    facets.in_surface.assign(cells_.size(), 0);
+    facets.wall.assign(cells_.size(), 0);
+    std::vector<std::pair<CellHandle, int>> facet_of(triangles.size(), {CellHandle(), -1});
+    std::vector<bool> open_component(triangles.size(), false);
+    for (std::uint32_t t = 0; t < triangles.size(); ++t) {
+      const Triangle &k = triangles[t];
+      CellHandle cell;
+      int i = 0, j = 0, l = 0;
+      if (delaunay_.is_facet(vertex_of_point_[k[0]], vertex_of_point_[k[1]], vertex_of_point_[k[2]],
+                             cell, i, j, l))
+        facet_of[t] = {cell, 6 - i - j - l}; // the corner not on the facet
+      if (touches_boundary[t] || facet_of[t].second < 0)
+        open_component[root(t)] = true;
+    }
+    for (std::uint32_t t = 0; t < triangles.size(); ++t) {
+      const bool wall = !open_component[root(t)];
+      if (!wall)
+        for (VertexIndex v : triangles[t])
+          facets.on_open_part[v] = true;
+      const auto [cell, opposite] = facet_of[t];
+      if (opposite < 0)
+        continue;
+      // Both cells that share the facet see it.
+      const CellHandle neighbour = cell->neighbor(opposite);
+      const int mirror = neighbour->index(cell);
+      facets.in_surface[cell->info()] |= std::uint8_t(1u << opposite);
+      facets.in_surface[neighbour->info()] |= std::uint8_t(1u << mirror);
+      if (wall) {
+        facets.wall[cell->info()] |= std::uint8_t(1u << opposite);
+        facets.wall[neighbour->info()] |= std::uint8_t(1u << mirror);
+      }
+    }
+    return facets;
+  }
+
+  /// Flood from the infinite cells across every facet that is not a wall:
+  /// cells it cannot reach are inside a closed component.
+  std::vector<std::uint8_t> cellSides(const SurfaceFacets &facets) const {
+    std::vector<bool> reached(cells_.size(), false);
+    std::deque<std::uint32_t> queue;
+    for (std::uint32_t c = 0; c < cells_.size(); ++c)
+      if (delaunay_.is_infinite(cells_[c])) {
+        reached[c] = true;
+        queue.push_back(c);
+      }
+    while (!queue.empty()) {
+      const std::uint32_t c = queue.front();
+      queue.pop_front();
+      for (int i = 0; i < 4; ++i) {
+        const std::uint32_t next = cells_[c]->neighbor(i)->info();
+        if (reached[next])
+          continue;
+        if (facets.wall[c] & (1u << i))
+          continue;
+        reached[next] = true;
+        queue.push_back(next);
+      }
+    }
+    std::vector<std::uint8_t> side(cells_.size(), MedialAxis::outside);
+    for (std::uint32_t c = 0; c < cells_.size(); ++c) {
+      if (!reached[c]) {
+        side[c] = MedialAxis::inside;
+        continue;
+      }
+      for (int k = 0; k < 4; ++k) {
+        const VertexHandle corner = cells_[c]->vertex(k);
+        if (!delaunay_.is_infinite(corner) && facets.on_open_part[corner->info()])
+          side[c] = MedialAxis::open;
+      }
+    }
+    return side;
+  }
+
+  /// Per point its poles (Amenta, Choi and Kolluri's power crust): the
+  /// farthest Voronoi vertex of its cell, and the farthest on the other
+  /// side of the point. A point on the convex hull has an unbounded cell:
+  /// its first pole is at infinity, in the direction of its hull facets'
+  /// outward normals, and is not a node.
+  std::vector<bool> findPoles() const {
+    std::vector<bool> is_pole(cells_.size(), false);
+    std::vector<CellHandle> incident;
+    // Farther wins; equal radii go to the cell with the smaller corners.
+    const auto farther = [&](std::uint32_t a, std::uint32_t b) {
+      if (balls_[a].radius != balls_[b].radius)
+        return balls_[a].radius > balls_[b].radius;
+      return std::lexicographical_compare(
+          balls_[a].corners.begin(), balls_[a].corners.end(), balls_[b].corners.begin(),
+          balls_[b].corners.end(),
+          [&](VertexIndex p, VertexIndex q) { return rank_[p] < rank_[q]; });
+    };
+    for (VertexIndex p : distinct_) {
+      const VertexHandle vertex = vertex_of_point_[p];
+      const Eigen::Vector3d &position = points_[p];
+      incident.clear();
+      delaunay_.incident_cells(vertex, std::back_inserter(incident));
+      Eigen::Vector3d outward = Eigen::Vector3d::Zero();
+      bool on_hull = false;
+      std::uint32_t first = no_cell;
+      for (CellHandle cell : incident) {
+        if (delaunay_.is_infinite(cell)) {
+          // The hull facet is the one opposite the infinite vertex; its
+          // normal points away from the finite cell behind it.
+          on_hull = true;
+          const int at_infinity = cell->index(delaunay_.infinite_vertex());
+          const Eigen::Vector3d a = toEigen(cell->vertex((at_infinity + 1) & 3)->point()),
+                                b = toEigen(cell->vertex((at_infinity + 2) & 3)->point()),
+                                c = toEigen(cell->vertex((at_infinity + 3) & 3)->point());
+          Eigen::Vector3d normal = (b - a).cross(c - a);
+          const CellHandle behind = cell->neighbor(at_infinity);
+          const Eigen::Vector3d inner = toEigen(behind->vertex(behind->index(cell))->point());
+          if (normal.dot(inner - a) > 0)
+            normal = -normal;
+          const double length = normal.norm();
+          if (length > 0)
+            outward += normal / length;
+          continue;
+        }
+        const std::uint32_t c = cell->info();
+        if (balls_[c].valid && (first == no_cell || farther(c, first)))
+          first = c;
+      }
+      if (first == no_cell)
+        continue;
+      if (on_hull) {
+        if (outward.squaredNorm() == 0)
+          continue;
+      } else {
+        is_pole[first] = true;
+        outward = balls_[first].centre - position;
+      }
+      std::uint32_t second = no_cell;
+      for (CellHandle cell : incident) {
+        if (delaunay_.is_infinite(cell))
+          continue;
+        const std::uint32_t c = cell->info();
+        if (balls_[c].valid && (balls_[c].centre - position).dot(outward) < 0 &&
+            (second == no_cell || farther(c, second)))
+          second = c;
+      }
+      if (second != no_cell)
+        is_pole[second] = true;
+    }
+    return is_pole;
+  }
+
+  const std::vector<Eigen::Vector3d> &points_;
+  std::vector<VertexIndex> representative_;
+  std::vector<VertexIndex> distinct_; // in coordinate order
+  /// A distinct point's place in that order: comparing ranks compares the
+  /// points by coordinates.
+  std::vector<VertexIndex> rank_;
+  Delaunay delaunay_;
+  std::vector<VertexHandle> vertex_of_point_;
+  std::vector<CellHandle> cells_;
+  std::vector<CellBall> balls_;
+};
+
+} // namespace
+
+MedialAxis computeMedialAxis(const std::vector<Eigen::Vector3d> &points,
+                             const std::vector<Triangle> &surface) {
+  if (points.size() >= std::numeric_limits<VertexIndex>::max())
+    throw ReconstructionError("too many points for 32-bit indices");
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (!points[i].allFinite())
+      throw ReconstructionError("medial axis: point " + std::to_string(i) +
+                                " has a NaN or infinite coordinate");
+  for (std::size_t t = 0; t < surface.size(); ++t)
+    for (VertexIndex v : surface[t])
+      if (v >= points.size())
+        throw ReconstructionError("medial axis: triangle " + std::to_string(t) + " uses point " +
+                                  std::to_string(v) + " of " + std::to_string(points.size()));
+  return MedialAxisBuilder(points).build(surface);
+}
+
+} // namespace pcl_ms
