@@ -45,7 +45,8 @@ constexpr std::uint32_t no_cell = std::numeric_limits<std::uint32_t>::max();
 // fixes where along the surface normal their centre lies (on a sampled unit
 // sphere such poles were up to 0.07 off the centre with 5,000 points and 0.37
 // with 20,000; the wide ones less than 1e-6).
-// 45 degrees keeps the medial sheets of ridges up to 135 degrees sharp.
+// At 45 degrees the sheets that run into an edge are kept where its two faces
+// meet at up to 135 degrees.
 constexpr double min_contact_angle = M_PI / 4;
 
 bool lessPoint(const Eigen::Vector3d &a, const Eigen::Vector3d &b) {
@@ -263,38 +264,48 @@ private:
     // A component is open when one of its edges is a boundary edge, or when
     // one of its triangles is not a Delaunay facet (a hole filled across
     // other triangles): the flood below could leak past it.
+    // The triangles by their first corner (they are sorted), so that one
+    // sweep over the cells' facets finds them.
+    std::vector<std::uint32_t> first_of(points_.size() + 1, 0);
+    for (const Triangle &k : triangles)
+      ++first_of[k[0] + 1];
+    std::partial_sum(first_of.begin(), first_of.end(), first_of.begin());
+    struct Hit {
+      std::uint32_t cell;
+      int facet;
+      std::uint32_t triangle;
+    };
+    std::vector<Hit> hits; // each Delaunay surface triangle twice, once per side
+    std::vector<bool> is_facet(triangles.size(), false);
     facets.in_surface.assign(cells_.size(), 0);
-    facets.wall.assign(cells_.size(), 0);
-    std::vector<std::pair<CellHandle, int>> facet_of(triangles.size(), {CellHandle(), -1});
-    std::vector<bool> open_component(triangles.size(), false);
-    for (std::uint32_t t = 0; t < triangles.size(); ++t) {
-      const Triangle &k = triangles[t];
-      CellHandle cell;
-      int i = 0, j = 0, l = 0;
-      if (delaunay_.is_facet(vertex_of_point_[k[0]], vertex_of_point_[k[1]], vertex_of_point_[k[2]],
-                             cell, i, j, l))
-        facet_of[t] = {cell, 6 - i - j - l}; // the corner not on the facet
-      if (touches_boundary[t] || facet_of[t].second < 0)
-        open_component[root(t)] = true;
-    }
-    for (std::uint32_t t = 0; t < triangles.size(); ++t) {
-      const bool wall = !open_component[root(t)];
-      if (!wall)
-        for (VertexIndex v : triangles[t])
-          facets.on_open_part[v] = true;
-      const auto [cell, opposite] = facet_of[t];
-      if (opposite < 0)
-        continue;
-      // Both cells that share the facet see it.
-      const CellHandle neighbour = cell->neighbor(opposite);
-      const int mirror = neighbour->index(cell);
-      facets.in_surface[cell->info()] |= std::uint8_t(1u << opposite);
-      facets.in_surface[neighbour->info()] |= std::uint8_t(1u << mirror);
-      if (wall) {
-        facets.wall[cell->info()] |= std::uint8_t(1u << opposite);
-        facets.wall[neighbour->info()] |= std::uint8_t(1u << mirror);
+    for (std::uint32_t c = 0; c < cells_.size(); ++c) {
+      for (int i = 0; i < 4; ++i) {
+        if (delaunay_.is_infinite(cells_[c], i))
+          continue;
+        const Triangle key = sortedTriangle(cells_[c]->vertex((i + 1) & 3)->info(),
+                                            cells_[c]->vertex((i + 2) & 3)->info(),
+                                            cells_[c]->vertex((i + 3) & 3)->info());
+        for (std::uint32_t t = first_of[key[0]]; t < first_of[key[0] + 1]; ++t)
+          if (triangles[t] == key) {
+            facets.in_surface[c] |= std::uint8_t(1u << i);
+            is_facet[t] = true;
+            hits.push_back({c, i, t});
+            break;
+          }
       }
     }
+    std::vector<bool> open_component(triangles.size(), false);
+    for (std::uint32_t t = 0; t < triangles.size(); ++t)
+      if (touches_boundary[t] || !is_facet[t])
+        open_component[root(t)] = true;
+    for (std::uint32_t t = 0; t < triangles.size(); ++t)
+      if (open_component[root(t)])
+        for (VertexIndex v : triangles[t])
+          facets.on_open_part[v] = true;
+    facets.wall.assign(cells_.size(), 0);
+    for (const Hit &hit : hits)
+      if (!open_component[root(hit.triangle)])
+        facets.wall[hit.cell] |= std::uint8_t(1u << hit.facet);
     return facets;
   }
 
@@ -340,10 +351,9 @@ private:
   /// farthest Voronoi vertex of its cell, and the farthest on the other
   /// side of the point. A point on the convex hull has an unbounded cell:
   /// its first pole is at infinity, in the direction of its hull facets'
-  /// outward normals, and is not a node.
+  /// outward normals, and is not a node. Two sweeps over the cells, each
+  /// visiting every corner, instead of a walk around every point.
   std::vector<bool> findPoles() const {
-    std::vector<bool> is_pole(cells_.size(), false);
-    std::vector<CellHandle> incident;
     // Farther wins; equal radii go to the cell with the smaller corners.
     const auto farther = [&](std::uint32_t a, std::uint32_t b) {
       if (balls_[a].radius != balls_[b].radius)
@@ -353,58 +363,58 @@ private:
           balls_[b].corners.end(),
           [&](VertexIndex p, VertexIndex q) { return rank_[p] < rank_[q]; });
     };
-    for (VertexIndex p : distinct_) {
-      const VertexHandle vertex = vertex_of_point_[p];
-      const Eigen::Vector3d &position = points_[p];
-      incident.clear();
-      delaunay_.incident_cells(vertex, std::back_inserter(incident));
-      Eigen::Vector3d outward = Eigen::Vector3d::Zero();
-      bool on_hull = false;
-      std::uint32_t first = no_cell;
-      for (CellHandle cell : incident) {
-        if (delaunay_.is_infinite(cell)) {
-          // The hull facet is the one opposite the infinite vertex; its
-          // normal points away from the finite cell behind it.
-          on_hull = true;
-          const int at_infinity = cell->index(delaunay_.infinite_vertex());
-          const Eigen::Vector3d a = toEigen(cell->vertex((at_infinity + 1) & 3)->point()),
-                                b = toEigen(cell->vertex((at_infinity + 2) & 3)->point()),
-                                c = toEigen(cell->vertex((at_infinity + 3) & 3)->point());
-          Eigen::Vector3d normal = (b - a).cross(c - a);
-          const CellHandle behind = cell->neighbor(at_infinity);
-          const Eigen::Vector3d inner = toEigen(behind->vertex(behind->index(cell))->point());
-          if (normal.dot(inner - a) > 0)
-            normal = -normal;
-          const double length = normal.norm();
+    std::vector<std::uint32_t> first(points_.size(), no_cell), second(points_.size(), no_cell);
+    std::vector<Eigen::Vector3d> outward(points_.size(), Eigen::Vector3d::Zero());
+    std::vector<bool> on_hull(points_.size(), false);
+    for (std::uint32_t c = 0; c < cells_.size(); ++c) {
+      const CellHandle cell = cells_[c];
+      if (delaunay_.is_infinite(cell)) {
+        // The hull facet is the one opposite the infinite vertex; its
+        // normal points away from the finite cell behind it.
+        const int at_infinity = cell->index(delaunay_.infinite_vertex());
+        const VertexHandle corners[3] = {cell->vertex((at_infinity + 1) & 3),
+                                         cell->vertex((at_infinity + 2) & 3),
+                                         cell->vertex((at_infinity + 3) & 3)};
+        const Eigen::Vector3d a = toEigen(corners[0]->point()), b = toEigen(corners[1]->point()),
+                              d = toEigen(corners[2]->point());
+        Eigen::Vector3d normal = (b - a).cross(d - a);
+        const CellHandle behind = cell->neighbor(at_infinity);
+        if (normal.dot(toEigen(behind->vertex(behind->index(cell))->point()) - a) > 0)
+          normal = -normal;
+        const double length = normal.norm();
+        for (const VertexHandle &corner : corners) {
+          on_hull[corner->info()] = true;
           if (length > 0)
-            outward += normal / length;
-          continue;
+            outward[corner->info()] += normal / length;
         }
-        const std::uint32_t c = cell->info();
-        if (balls_[c].valid && (first == no_cell || farther(c, first)))
-          first = c;
-      }
-      if (first == no_cell)
         continue;
-      if (on_hull) {
-        if (outward.squaredNorm() == 0)
-          continue;
-      } else {
-        is_pole[first] = true;
-        outward = balls_[first].centre - position;
       }
-      std::uint32_t second = no_cell;
-      for (CellHandle cell : incident) {
-        if (delaunay_.is_infinite(cell))
-          continue;
-        const std::uint32_t c = cell->info();
-        if (balls_[c].valid && (balls_[c].centre - position).dot(outward) < 0 &&
-            (second == no_cell || farther(c, second)))
-          second = c;
-      }
-      if (second != no_cell)
-        is_pole[second] = true;
+      if (!balls_[c].valid)
+        continue;
+      for (VertexIndex p : balls_[c].corners)
+        if (first[p] == no_cell || farther(c, first[p]))
+          first[p] = c;
     }
+    std::vector<bool> is_pole(cells_.size(), false);
+    for (VertexIndex p : distinct_) {
+      if (first[p] == no_cell)
+        continue;
+      if (!on_hull[p]) {
+        is_pole[first[p]] = true;
+        outward[p] = balls_[first[p]].centre - points_[p];
+      }
+    }
+    for (std::uint32_t c = 0; c < cells_.size(); ++c) {
+      if (!balls_[c].valid)
+        continue;
+      for (VertexIndex p : balls_[c].corners)
+        if ((balls_[c].centre - points_[p]).dot(outward[p]) < 0 &&
+            (second[p] == no_cell || farther(c, second[p])))
+          second[p] = c;
+    }
+    for (VertexIndex p : distinct_)
+      if (second[p] != no_cell)
+        is_pole[second[p]] = true;
     return is_pole;
   }
 
