@@ -81,6 +81,14 @@ struct SurfaceFacets {
   /// whose triangles are all Delaunay facets, which separates inside from
   /// outside.
   std::vector<std::uint8_t> in_surface, wall;
+  /// The walls once each, as (cell, facet): both sides of a wall reached
+  /// from outside means the flood leaked past a closed component.
+  std::vector<std::pair<std::uint32_t, int>> wall_facets;
+  /// The first surface_walls of them are surface triangles, the rest plugs;
+  /// the component of each of those surface triangles.
+  std::size_t surface_walls = 0;
+  std::vector<std::uint32_t> wall_component; // a triangle's index stands for its component
+  std::size_t triangles = 0;
   /// Points on a component with a boundary (or one that cannot serve as a
   /// wall): cells touching them get no side.
   std::vector<bool> on_open_part;
@@ -261,23 +269,17 @@ private:
         parent[root(edges[e].triangle)] = root(edges[first].triangle);
       first = last;
     }
-    // A component is open when one of its edges is a boundary edge, or when
-    // one of its triangles is not a Delaunay facet (a hole filled across
-    // other triangles): the flood below could leak past it.
     // The triangles by their first corner (they are sorted), so that one
     // sweep over the cells' facets finds them.
     std::vector<std::uint32_t> first_of(points_.size() + 1, 0);
     for (const Triangle &k : triangles)
       ++first_of[k[0] + 1];
     std::partial_sum(first_of.begin(), first_of.end(), first_of.begin());
-    struct Hit {
-      std::uint32_t cell;
-      int facet;
-      std::uint32_t triangle;
-    };
-    std::vector<Hit> hits; // each Delaunay surface triangle twice, once per side
     std::vector<bool> is_facet(triangles.size(), false);
     facets.in_surface.assign(cells_.size(), 0);
+    facets.wall.assign(cells_.size(), 0);
+    std::vector<std::pair<std::uint32_t, int>> found; // (cell, facet) per surface triangle
+    std::vector<std::uint32_t> found_triangle;
     for (std::uint32_t c = 0; c < cells_.size(); ++c) {
       for (int i = 0; i < 4; ++i) {
         if (delaunay_.is_infinite(cells_[c], i))
@@ -288,25 +290,72 @@ private:
         for (std::uint32_t t = first_of[key[0]]; t < first_of[key[0] + 1]; ++t)
           if (triangles[t] == key) {
             facets.in_surface[c] |= std::uint8_t(1u << i);
+            if (!is_facet[t]) { // once per facet, from the first cell met
+              found.emplace_back(c, i);
+              found_triangle.push_back(t);
+            }
             is_facet[t] = true;
-            hits.push_back({c, i, t});
             break;
           }
       }
     }
+    // Only closed components, those without a boundary edge, can wall off
+    // an inside.
     std::vector<bool> open_component(triangles.size(), false);
     for (std::uint32_t t = 0; t < triangles.size(); ++t)
-      if (touches_boundary[t] || !is_facet[t])
+      if (touches_boundary[t])
         open_component[root(t)] = true;
     for (std::uint32_t t = 0; t < triangles.size(); ++t)
       if (open_component[root(t)])
         for (VertexIndex v : triangles[t])
           facets.on_open_part[v] = true;
-    facets.wall.assign(cells_.size(), 0);
-    for (const Hit &hit : hits)
-      if (!open_component[root(hit.triangle)])
-        facets.wall[hit.cell] |= std::uint8_t(1u << hit.facet);
+    for (std::size_t h = 0; h < found.size(); ++h)
+      if (!open_component[root(found_triangle[h])]) {
+        addWall(found[h].first, found[h].second, facets);
+        facets.wall_component.push_back(root(found_triangle[h]));
+      }
+    facets.triangles = triangles.size();
+    // Only these separate the inside from the outside; the plugs below may
+    // lie on either side.
+    facets.surface_walls = facets.wall_facets.size();
+    // A surface triangle that is no Delaunay facet (a swapped diagonal, a
+    // hole filled across other triangles) leaves a gap in the walls: the
+    // Delaunay facets among its corners and those of its neighbours across
+    // its edges close it (for a swapped pair, the other diagonal's two).
+    for (std::uint32_t t = 0; t < triangles.size(); ++t) {
+      if (is_facet[t] || open_component[root(t)])
+        continue;
+      std::vector<VertexIndex> around(triangles[t].begin(), triangles[t].end());
+      for (int e = 0; e < 3; ++e) {
+        const VertexIndex a = triangles[t][e == 2 ? 1 : 0], b = triangles[t][e == 0 ? 1 : 2];
+        auto use = std::lower_bound(edges.begin(), edges.end(), EdgeUse{a, b, 0});
+        for (; use != edges.end() && use->a == a && use->b == b; ++use)
+          around.insert(around.end(), triangles[use->triangle].begin(),
+                        triangles[use->triangle].end());
+      }
+      std::sort(around.begin(), around.end());
+      around.erase(std::unique(around.begin(), around.end()), around.end());
+      for (std::size_t i = 0; i < around.size(); ++i)
+        for (std::size_t j = i + 1; j < around.size(); ++j)
+          for (std::size_t k = j + 1; k < around.size(); ++k) {
+            CellHandle cell;
+            int ci = 0, cj = 0, ck = 0;
+            if (delaunay_.is_facet(vertex_of_point_[around[i]], vertex_of_point_[around[j]],
+                                   vertex_of_point_[around[k]], cell, ci, cj, ck))
+              addWall(cell->info(), 6 - ci - cj - ck, facets);
+          }
+    }
     return facets;
+  }
+
+  /// Makes facet `i` of cell `c` a wall, seen from both its cells.
+  void addWall(std::uint32_t c, int i, SurfaceFacets &facets) const {
+    if (facets.wall[c] & (1u << i))
+      return;
+    const CellHandle neighbour = cells_[c]->neighbor(i);
+    facets.wall[c] |= std::uint8_t(1u << i);
+    facets.wall[neighbour->info()] |= std::uint8_t(1u << neighbour->index(cells_[c]));
+    facets.wall_facets.emplace_back(c, i);
   }
 
   /// Flood from the infinite cells across every facet that is not a wall:
@@ -332,10 +381,29 @@ private:
         queue.push_back(next);
       }
     }
+    // A closed component that the flood got past (its walls did not close
+    // it off after all) has its inside among the reached cells: most of its
+    // triangles are then reached on both sides (a few can be where the
+    // surface folds close to a plugged gap: a small pocket, not a leak).
+    // The reached cells can then no longer be told apart: no side.
+    std::vector<std::size_t> walls_of(facets.triangles, 0), leaking_walls_of(facets.triangles, 0);
+    for (std::size_t w = 0; w < facets.surface_walls; ++w) {
+      const auto [c, i] = facets.wall_facets[w];
+      ++walls_of[facets.wall_component[w]];
+      if (reached[c] && reached[cells_[c]->neighbor(i)->info()])
+        ++leaking_walls_of[facets.wall_component[w]];
+    }
+    bool leaked = false;
+    for (std::size_t component = 0; component < walls_of.size(); ++component)
+      leaked = leaked || 2 * leaking_walls_of[component] > walls_of[component];
     std::vector<std::uint8_t> side(cells_.size(), MedialAxis::outside);
     for (std::uint32_t c = 0; c < cells_.size(); ++c) {
       if (!reached[c]) {
         side[c] = MedialAxis::inside;
+        continue;
+      }
+      if (leaked) {
+        side[c] = MedialAxis::open;
         continue;
       }
       for (int k = 0; k < 4; ++k) {

@@ -128,6 +128,42 @@ TEST(MedialAxis, TorusInnerNodesSitOnItsCoreCircle) {
   EXPECT_EQ(countSide(axis, MedialAxis::open), 0u);
 }
 
+TEST(MedialAxis, NonDelaunayTrianglesStillWallOffTheInside) {
+  // Swap the diagonals of quads of a sampled sphere's mesh: the new
+  // triangles are not Delaunay facets (the sphere's are its hull), so the
+  // walls have gaps that only the plugs close.
+  const std::vector<float> xyz = randomSphere(3000, 1.0, Eigen::Vector3d::Zero(), 13);
+  const pcl_ms::Result result = pcl_ms::reconstruct(viewOf(xyz), pcl_ms::Parameters());
+  ASSERT_TRUE(result.boundary_loops.empty());
+  std::vector<pcl_ms::Triangle> triangles = result.triangles;
+  std::vector<bool> touched(xyz.size() / 3, false);
+  std::size_t swapped = 0;
+  for (std::size_t t = 0; t < triangles.size() && swapped < 20; ++t)
+    for (std::size_t u = t + 1; u < triangles.size(); ++u) {
+      // Shared edge (a, b), apexes c and d, all untouched so far.
+      std::vector<pcl_ms::VertexIndex> shared, apexes;
+      for (pcl_ms::VertexIndex v : triangles[t])
+        (std::count(triangles[u].begin(), triangles[u].end(), v) ? shared : apexes).push_back(v);
+      if (shared.size() != 2)
+        continue;
+      for (pcl_ms::VertexIndex v : triangles[u])
+        if (!std::count(shared.begin(), shared.end(), v))
+          apexes.push_back(v);
+      if (touched[shared[0]] || touched[shared[1]] || touched[apexes[0]] || touched[apexes[1]])
+        break;
+      triangles[t] = {apexes[0], apexes[1], shared[0]};
+      triangles[u] = {apexes[0], apexes[1], shared[1]};
+      for (pcl_ms::VertexIndex v : {shared[0], shared[1], apexes[0], apexes[1]})
+        touched[v] = true;
+      ++swapped;
+      break;
+    }
+  ASSERT_EQ(swapped, 20u);
+  const MedialAxis axis = pcl_ms::computeMedialAxis(pcl_ms_test::positions(xyz), triangles);
+  ASSERT_GT(axis.node_positions.size(), 10u);
+  EXPECT_EQ(countSide(axis, MedialAxis::inside), axis.node_positions.size());
+}
+
 TEST(MedialAxis, OffByDefaultAndTheMeshIsTheSameEitherWay) {
   const std::vector<float> xyz = randomSphere(3000, 1.0, Eigen::Vector3d::Zero(), 7);
   EXPECT_FALSE(pcl_ms::Parameters().compute_medial_axis);
