@@ -299,4 +299,29 @@ TEST_F(MedialAxisTool, WritesNodesWithRadiusAndCurvesAsEdges) {
             1);
 }
 
+TEST_F(MedialAxisTool, CompareDrawsItBesideTheSurface) {
+  const std::vector<float> xyz = randomTorus(4000, 1.0, 0.3, 17);
+  std::string text;
+  for (std::size_t i = 0; i < xyz.size(); i += 3)
+    text += std::to_string(xyz[i]) + " " + std::to_string(xyz[i + 1]) + " " +
+            std::to_string(xyz[i + 2]) + "\n";
+  pcl_ms_test::writeFile(path("torus.xyz"), text);
+  const std::string compare = std::string(PCL_MS_BINARY_DIR) + "/pcl_ms_compare";
+  const std::string common = pcl_ms_test::quoted(path("torus.xyz")) +
+                             " -methods pcl_ms -picture_size 200 -q -out " +
+                             pcl_ms_test::quoted(path("out"));
+  ASSERT_EQ(runProgram(compare, common + " -medial_axis"), 0) << stderr_;
+  const std::string ply = pcl_ms_test::readFile(path("out/medial_axis.ply"));
+  EXPECT_TRUE(
+      pcl_ms_test::contains(ply.substr(0, ply.find("end_header")), "property float radius"));
+  // The picture needs the renderer; without it there is one warning line.
+  if (!pcl_ms_test::contains(stderr_, "warning: pictures not written")) {
+    EXPECT_EQ(pcl_ms_test::readFile(path("out/medial_axis.png")).substr(0, 8), "\x89PNG\r\n\x1a\n");
+  }
+  // Without the option, an earlier run's medial axis files go.
+  ASSERT_EQ(runProgram(compare, common), 0) << stderr_;
+  EXPECT_FALSE(pcl_ms_test::fs::exists(path("out/medial_axis.ply")));
+  EXPECT_FALSE(pcl_ms_test::fs::exists(path("out/medial_axis.png")));
+}
+
 } // namespace
