@@ -5,13 +5,12 @@
 #include <pcl_ms/medial_axis.h>
 #include <pcl_ms/reconstruct.h>
 
-#include "flat_cells.h"
-
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Delaunay_triangulation_cell_base_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_cell_base_with_info_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
+#include <CGAL/constructions/kernel_ftC3.h>
 
 #include <algorithm>
 #include <cmath>
@@ -69,7 +68,7 @@ struct CellBall {
   std::array<VertexIndex, 4> corners; // ascending by coordinates
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   double radius = 0;
-  bool valid = false; // false: no circumcentre in double (flat_cells.h)
+  bool valid = false; // false: no circumcentre in double (a flat cell)
   /// Whether two corners subtend at least min_contact_angle at the centre.
   bool wide = false;
 };
@@ -196,18 +195,24 @@ private:
     balls_.resize(cells_.size());
     for (std::uint32_t c = 0; c < cells_.size(); ++c) {
       const CellHandle cell = cells_[c];
-      if (delaunay_.is_infinite(cell) || detail::hasNoCircumcentre(cell))
+      if (delaunay_.is_infinite(cell))
         continue;
       CellBall &ball = balls_[c];
       for (int k = 0; k < 4; ++k)
         ball.corners[k] = cell->vertex(k)->info();
       std::sort(ball.corners.begin(), ball.corners.end(),
                 [&](VertexIndex p, VertexIndex q) { return rank_[p] < rank_[q]; });
-      const KernelPoint centre = CGAL::circumcenter(
-          vertex_of_point_[ball.corners[0]]->point(), vertex_of_point_[ball.corners[1]]->point(),
-          vertex_of_point_[ball.corners[2]]->point(), vertex_of_point_[ball.corners[3]]->point());
-      ball.centre = toEigen(centre);
-      ball.radius = (ball.centre - points_[ball.corners[0]]).norm();
+      // CGAL's circumcentre construction (circumcenterC3), but with a flat
+      // cell's zero volume checked instead of asserted (as in flat_cells.h).
+      const Eigen::Vector3d &p = points_[ball.corners[0]], &q = points_[ball.corners[1]],
+                            &r = points_[ball.corners[2]], &t = points_[ball.corners[3]];
+      double num_x, num_y, num_z, den;
+      CGAL::determinants_for_circumcenterC3(p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), r.x(), r.y(),
+                                            r.z(), t.x(), t.y(), t.z(), num_x, num_y, num_z, den);
+      if (den == 0)
+        continue;
+      ball.centre = p + Eigen::Vector3d(num_x, -num_y, num_z) / (2 * den);
+      ball.radius = (ball.centre - p).norm();
       double longest = 0;
       for (int a = 0; a < 4; ++a)
         for (int b = a + 1; b < 4; ++b)
