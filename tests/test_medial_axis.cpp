@@ -197,6 +197,23 @@ TEST(MedialAxis, SameAxisWhateverThePointOrder) {
   EXPECT_EQ(reversed.curves, axis.curves);
 }
 
+TEST(MedialAxis, SameFromReconstructWhateverTheOrderAndThreads) {
+  const std::vector<float> xyz = randomTorus(3000, 1.0, 0.3, 19);
+  std::vector<float> reversed;
+  for (std::size_t i = xyz.size(); i >= 3; i -= 3)
+    reversed.insert(reversed.end(), {xyz[i - 3], xyz[i - 2], xyz[i - 1]});
+  pcl_ms::Parameters parameters;
+  parameters.compute_medial_axis = true;
+  const MedialAxis one = *pcl_ms::reconstruct(viewOf(xyz), parameters).medial_axis;
+  parameters.num_threads = 2;
+  const MedialAxis other = *pcl_ms::reconstruct(viewOf(reversed), parameters).medial_axis;
+  EXPECT_GT(one.node_positions.size(), 0u);
+  EXPECT_EQ(other.node_positions, one.node_positions);
+  EXPECT_EQ(other.node_radii, one.node_radii);
+  EXPECT_EQ(other.node_side, one.node_side);
+  EXPECT_EQ(other.curves, one.curves);
+}
+
 TEST(MedialAxis, OpenSurfaceGivesNoInside) {
   // A hemisphere: everything is reachable from outside past its rim.
   std::vector<float> xyz = randomSphere(3000, 1.0, Eigen::Vector3d::Zero(), 5), upper;
@@ -297,6 +314,12 @@ TEST_F(MedialAxisTool, WritesNodesWithRadiusAndCurvesAsEdges) {
   EXPECT_EQ(runProgram(tool(), pcl_ms_test::quoted(path("sphere.xyz")) + " " +
                                    pcl_ms_test::quoted(path("mesh3.ply")) + " -medial_axis"),
             1);
+  EXPECT_EQ(runProgram(tool(), pcl_ms_test::quoted(path("sphere.xyz")) + " " +
+                                   pcl_ms_test::quoted(path("mesh4.ply")) + " -medial_axis " +
+                                   pcl_ms_test::quoted(path("missing/axis.ply"))),
+            2);
+  EXPECT_TRUE(pcl_ms_test::contains(stderr_, "does not exist")) << stderr_;
+  EXPECT_FALSE(pcl_ms_test::fs::exists(path("mesh4.ply")));
 }
 
 TEST_F(MedialAxisTool, CompareDrawsItBesideTheSurface) {
