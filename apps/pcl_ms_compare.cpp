@@ -12,6 +12,7 @@
 #include "tool_support.h"
 
 #include <pcl_ms/io.h>
+#include <pcl_ms/medial_axis.h>
 #include <pcl_ms/mesh_quality.h>
 
 #include <pcl/PolygonMesh.h>
@@ -36,7 +37,8 @@ using namespace pcl_ms_tools;
 struct Options {
   std::string input, reference, out_dir = "compare_out";
   std::vector<Method> methods = allMethods();
-  int picture_size = 800; // pixels, width and height of each method's picture
+  int picture_size = 800;   // pixels, width and height of each method's picture
+  bool medial_axis = false; // also pcl_ms's medial axis: a PLY and a picture
   bool quiet = false;
   bool help = false;
 };
@@ -44,7 +46,8 @@ struct Options {
 void printHelp(const char *program) {
   std::printf(
       "Meshes a point cloud with pcl_ms and three other methods and compares the results.\n\n"
-      "Usage: %s input [-gt reference_mesh] [-out DIR] [-methods list] [-picture_size N] [-q]\n\n"
+      "Usage: %s input [-gt reference_mesh] [-out DIR] [-methods list] [-picture_size N]\n"
+      "          [-medial_axis] [-q]\n\n"
       "  input         point cloud: .pcd, .ply, .xyz or .txt\n"
       "  -gt FILE      reference surface (.ply, .obj, .off, .vtk): adds triangle recall and\n"
       "                precision (vertices matched by position), distances and F-scores\n"
@@ -53,6 +56,8 @@ void printHelp(const char *program) {
       "                (default: all four)\n"
       "  -picture_size N\n"
       "                width and height of each method's picture in pixels (default 800)\n"
+      "  -medial_axis  also write pcl_ms's medial axis: medial_axis.ply and a picture of its\n"
+      "                nodes (those inside, if the surface has an inside) beside the surface\n"
       "  -q            quiet: no progress, only warnings and errors\n"
       "  -h            this help\n\n"
       "Writes results.md, results.csv, <method>.ply, <method>.png and side_by_side.png.\n"
@@ -109,6 +114,8 @@ bool parseArguments(int argc, char **argv, Options &options, std::string &error)
       options.help = true;
     } else if (argument == "-q") {
       options.quiet = true;
+    } else if (argument == "-medial_axis") {
+      options.medial_axis = true;
     } else if (argument == "-gt" || argument == "-out" || argument == "-methods" ||
                argument == "-picture_size") {
       if (i + 1 >= argc) {
@@ -337,9 +344,37 @@ bool saveRunMesh(const std::string &path, const PeerRun &run, std::string &error
   return pcl_ms::saveMesh(path, mesh, error);
 }
 
+/// The medial axis's nodes as small octahedra, so that the mesh renderer can
+/// draw them: those inside the surface when it has an inside, else all.
+void medialAxisGlyphs(const pcl_ms::MedialAxis &axis, double size,
+                      std::vector<Eigen::Vector3d> &vertices,
+                      std::vector<pcl_ms::Triangle> &triangles) {
+  const bool has_inside =
+      std::count(axis.node_side.begin(), axis.node_side.end(), pcl_ms::MedialAxis::inside) > 0;
+  for (std::size_t n = 0; n < axis.node_positions.size(); ++n) {
+    if (has_inside && axis.node_side[n] != pcl_ms::MedialAxis::inside)
+      continue;
+    const auto first = static_cast<pcl_ms::VertexIndex>(vertices.size());
+    for (int axis_index = 0; axis_index < 3; ++axis_index)
+      for (double sign : {1.0, -1.0})
+        vertices.push_back(axis.node_positions[n] +
+                           sign * size * Eigen::Vector3d::Unit(axis_index));
+    // Corners 0/1 on x, 2/3 on y, 4/5 on z; one face per octant, outward.
+    for (int x : {0, 1})
+      for (int y : {2, 3})
+        for (int z : {4, 5}) {
+          const bool flip = (x + y + z) % 2 == 1;
+          triangles.push_back({first + pcl_ms::VertexIndex(x),
+                               first + pcl_ms::VertexIndex(flip ? z : y),
+                               first + pcl_ms::VertexIndex(flip ? y : z)});
+        }
+  }
+}
+
 /// Pictures are a bonus: when they cannot be made, say so once and go on.
 void writePictures(const fs::path &dir, const std::vector<Eigen::Vector3d> &points,
-                   const std::vector<Entry> &entries, int picture_size, bool verbose) {
+                   const std::vector<Entry> &entries, int picture_size, bool verbose,
+                   const pcl_ms::MedialAxis *medial_axis) {
   const RenderView view = viewFramingPoints(points);
   std::vector<std::string> pictures;
   std::string error;
@@ -356,6 +391,25 @@ void writePictures(const fs::path &dir, const std::vector<Eigen::Vector3d> &poin
       return;
     }
     pictures.push_back(path);
+    if (entry.run.method != Method::pcl_ms || !medial_axis)
+      continue;
+    // pcl_ms's medial axis beside its surface, same camera.
+    Eigen::Vector3d low = points.front(), high = points.front();
+    for (const Eigen::Vector3d &p : points) {
+      low = low.cwiseMin(p);
+      high = high.cwiseMax(p);
+    }
+    std::vector<Eigen::Vector3d> glyph_vertices;
+    std::vector<pcl_ms::Triangle> glyph_triangles;
+    medialAxisGlyphs(*medial_axis, 0.003 * (high - low).norm(), glyph_vertices, glyph_triangles);
+    options.caption = methodLabel(entry.run.method) + " medial axis";
+    const std::string axis_path = (dir / "medial_axis.png").string();
+    if (!renderMeshPng(glyph_vertices, glyph_triangles, view, options, axis_path, error)) {
+      std::fflush(stdout);
+      std::fprintf(stderr, "warning: pictures not written: %s\n", error.c_str());
+      return;
+    }
+    pictures.push_back(axis_path);
   }
   if (pictures.empty())
     return;
@@ -454,6 +508,8 @@ int run(int argc, char **argv) {
     for (const char *extension : {".ply", ".png"})
       fs::remove(dir / (methodKey(method) + extension), code);
   fs::remove(dir / "side_by_side.png", code);
+  fs::remove(dir / "medial_axis.ply", code);
+  fs::remove(dir / "medial_axis.png", code);
 
   const std::vector<Eigen::Vector3d> input_positions = positions(points);
   for (Entry &entry : entries) {
@@ -473,6 +529,18 @@ int run(int argc, char **argv) {
     if (!saveRunMesh(mesh_path, entry.run, error))
       return fail(kIoFailure, error);
   }
+  std::optional<pcl_ms::MedialAxis> medial_axis;
+  for (const Entry &entry : entries)
+    if (options.medial_axis && entry.run.ok && entry.run.method == Method::pcl_ms) {
+      // The mesh's vertices are the input points, so its own triangles serve.
+      medial_axis = pcl_ms::computeMedialAxis(entry.run.vertices, entry.run.triangles);
+      if (!pcl_ms::saveMedialAxis((dir / "medial_axis.ply").string(), *medial_axis, error))
+        return fail(kIoFailure, error);
+      if (verbose)
+        std::printf("Medial axis: %s nodes, %s curves\n",
+                    withThousands(medial_axis->node_positions.size()).c_str(),
+                    withThousands(medial_axis->curves.size()).c_str());
+    }
 
   const std::string csv_path = (dir / "results.csv").string();
   const std::string md_path = (dir / "results.md").string();
@@ -480,7 +548,8 @@ int run(int argc, char **argv) {
       !writeMarkdown(md_path, options, points.size(), skipped, entries, baseline_mb, with_reference,
                      reference_triangles.size(), error))
     return fail(kIoFailure, error);
-  writePictures(dir, input_positions, entries, options.picture_size, verbose);
+  writePictures(dir, input_positions, entries, options.picture_size, verbose,
+                medial_axis ? &*medial_axis : nullptr);
   if (verbose) {
     std::printf("Wrote %s and %s\n", md_path.c_str(), csv_path.c_str());
   }

@@ -73,6 +73,9 @@ int run(int argc, char **argv) {
   // Catch output problems before spending time on the reconstruction.
   if (const int code = pcl_ms_tools::checkMeshOutput(options.output, error); code != kSuccess)
     return fail(code, error);
+  if (const int code = pcl_ms_tools::checkMedialAxisOutput(options.medial_axis, error);
+      code != kSuccess)
+    return fail(code, error);
 
   const bool verbose = !options.quiet;
   pcl::PCLPointCloud2 cloud;
@@ -119,6 +122,9 @@ int run(int argc, char **argv) {
   double save_ms = 0;
   if (const int code = pcl_ms_tools::saveReconstructedMesh(options, std::move(cloud),
                                                            std::move(polygons), save_ms, error);
+      code != kSuccess)
+    return fail(code, error);
+  if (const int code = pcl_ms_tools::saveReconstructedMedialAxis(options, result, error);
       code != kSuccess)
     return fail(code, error);
   if (verbose)

@@ -157,6 +157,8 @@ int run(const Job &job, int argc, char **argv) {
   if (on_rank_zero) {
     status = pcl_ms_tools::checkMeshOutput(options.output, error);
     if (status == kSuccess)
+      status = pcl_ms_tools::checkMedialAxisOutput(options.medial_axis, error);
+    if (status == kSuccess)
       status = pcl_ms_tools::loadReconstructInput(options, parameters, cloud, load_ms, error);
   }
   status = statusOfRankZero(job, status);
@@ -204,9 +206,12 @@ int run(const Job &job, int argc, char **argv) {
   }
 
   double save_ms = 0;
-  if (on_rank_zero)
+  if (on_rank_zero) {
     status = pcl_ms_tools::saveReconstructedMesh(options, std::move(cloud), std::move(polygons),
                                                  save_ms, error);
+    if (status == kSuccess)
+      status = pcl_ms_tools::saveReconstructedMedialAxis(options, result, error);
+  }
   RankFigures mine{peakResidentMegabytes(), result.peak_memory.prepare / 1048576.0,
                    reconstruct_seconds, static_cast<double>(exchange.bytesSent()) / (1 << 20),
                    static_cast<double>(exchange.bytesReceived()) / (1 << 20)};

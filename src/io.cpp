@@ -1689,4 +1689,78 @@ bool saveMesh(const std::string &path, const pcl::PolygonMesh &mesh, std::string
   return ok;
 }
 
+bool saveMedialAxis(const std::string &path, const MedialAxis &axis, std::string &error,
+                    bool binary) {
+  const std::size_t nodes = axis.node_positions.size();
+  std::string reason;
+  if (fileExtension(path) != ".ply")
+    reason = unknownFormat(fileExtension(path), "medial axis", ".ply");
+  else if (axis.node_radii.size() != nodes || axis.node_side.size() != nodes)
+    reason = "the medial axis has " + std::to_string(nodes) + " nodes but " +
+             std::to_string(axis.node_radii.size()) + " radii and " +
+             std::to_string(axis.node_side.size()) + " sides";
+  else if (nodes > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
+    reason = "too many nodes for PLY's int indices";
+  for (std::size_t c = 0; reason.empty() && c < axis.curves.size(); ++c)
+    if (axis.curves[c][0] >= nodes || axis.curves[c][1] >= nodes)
+      reason = "curve " + std::to_string(c) + " joins a node that does not exist";
+  std::error_code code;
+  if (reason.empty() && fs::is_directory(path, code))
+    reason = "is a directory";
+  if (!reason.empty()) {
+    error = path + ": " + reason;
+    return false;
+  }
+
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) {
+    error = path + ": cannot open for writing: " + std::strerror(errno);
+    return false;
+  }
+  out << "ply\nformat "
+      << (!binary                ? "ascii"
+          : hostIsLittleEndian() ? "binary_little_endian"
+                                 : "binary_big_endian")
+      << " 1.0\n"
+      << "comment pcl_ms medial axis: A1^4 nodes (Voronoi vertices that are poles) with the\n"
+      << "comment radius of their maximal ball; inside 1 = inside a closed component,\n"
+      << "comment 0 = outside, 2 = next to an open part; edges are A1^3 shock curves\n"
+      << "element vertex " << nodes << "\n"
+      << "property float x\nproperty float y\nproperty float z\nproperty float radius\n"
+      << "property uchar inside\n"
+      << "element edge " << axis.curves.size() << "\n"
+      << "property int vertex1\nproperty int vertex2\nend_header\n";
+  if (binary) {
+    for (std::size_t n = 0; n < nodes; ++n) {
+      const float values[4] = {static_cast<float>(axis.node_positions[n].x()),
+                               static_cast<float>(axis.node_positions[n].y()),
+                               static_cast<float>(axis.node_positions[n].z()),
+                               static_cast<float>(axis.node_radii[n])};
+      out.write(reinterpret_cast<const char *>(values), sizeof(values));
+      out.put(static_cast<char>(axis.node_side[n]));
+    }
+    for (const auto &curve : axis.curves) {
+      const std::int32_t ends[2] = {static_cast<std::int32_t>(curve[0]),
+                                    static_cast<std::int32_t>(curve[1])};
+      out.write(reinterpret_cast<const char *>(ends), sizeof(ends));
+    }
+  } else {
+    out.precision(std::numeric_limits<float>::max_digits10);
+    for (std::size_t n = 0; n < nodes; ++n)
+      out << static_cast<float>(axis.node_positions[n].x()) << ' '
+          << static_cast<float>(axis.node_positions[n].y()) << ' '
+          << static_cast<float>(axis.node_positions[n].z()) << ' '
+          << static_cast<float>(axis.node_radii[n]) << ' ' << int(axis.node_side[n]) << '\n';
+    for (const auto &curve : axis.curves)
+      out << curve[0] << ' ' << curve[1] << '\n';
+  }
+  out.close();
+  if (!out) {
+    fs::remove(path, code);
+    error = path + ": writing failed";
+    return false;
+  }
+  return true;
+}
+
 } // namespace pcl_ms

@@ -2,6 +2,7 @@
 #include <pcl_ms/buckets.h>
 #include <pcl_ms/finish.h>
 #include <pcl_ms/greedy.h>
+#include <pcl_ms/medial_axis.h>
 #include <pcl_ms/reconstruct.h>
 #include <pcl_ms/scaffold.h>
 
@@ -460,6 +461,19 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
   deadline.check("the finish");
   if (!fixed.empty() || !preferred.empty())
     result.initial_kept = countKept(fixed.empty() ? preferred : fixed, surface.triangles);
+  result.timings.finish = secondsSince(stage);
+  result.peak_memory.finish = std::max(result.peak_memory.greedy, peakResidentBytes());
+  if (parameters.compute_medial_axis) {
+    // Read off a Delaunay triangulation of all prepared points (buckets
+    // never had one of the whole cloud); nothing of this runs when off.
+    stage = Clock::now();
+    MedialAxis axis = computeMedialAxis(prepared.positions, surface.triangles);
+    for (Eigen::Vector3d &position : axis.node_positions)
+      position += prepared.centre;
+    result.medial_axis = std::move(axis);
+    result.timings.medial_axis = secondsSince(stage);
+    deadline.check("the medial axis");
+  }
   // Back to the user's records.
   for (Triangle &triangle : surface.triangles)
     for (VertexIndex &v : triangle)
@@ -473,8 +487,6 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
   result.component_orientable = std::move(surface.component_orientable);
   result.holes_filled = surface.holes_filled;
   result.twist_triangles_removed = surface.twist_triangles_removed;
-  result.timings.finish = secondsSince(stage);
-  result.peak_memory.finish = std::max(result.peak_memory.greedy, peakResidentBytes());
   result.timings.total = secondsSince(start);
   return result;
 }

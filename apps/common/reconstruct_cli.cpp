@@ -106,6 +106,9 @@ void printReconstructHelp(const char *program, const char *summary) {
   print_info("  -keep_layout    write every point of the cloud, in its order and organized\n"
              "                  layout, points without a position (NaN) too (default: those\n"
              "                  are left out of the file, which mesh viewers cannot read)\n");
+  print_info("  -medial_axis F.ply  also write the medial axis the surface leaves: its nodes\n"
+             "                  (x y z, radius, inside: 1 inside a closed component, 0 outside,\n"
+             "                  2 next to an open part) and its curves as edges\n");
   print_info("  -q              quiet: print nothing but errors\n");
   print_info("  -h              this help\n\n");
   print_info("Exit status: 0 success, 1 bad arguments, 2 file error, 3 reconstruction failed.\n");
@@ -114,8 +117,8 @@ void printReconstructHelp(const char *program, const char *summary) {
 bool parseReconstructArguments(int argc, char **argv, ReconstructOptions &options,
                                std::string &error) {
   const std::vector<std::string> value_options = {
-      "-rho",       "-fill_holes", "-threads",          "-bucket_points", "-grid",
-      "-viewpoint", "-time_limit", "-estimate_normals", "-initial",       "-initial_mode"};
+      "-rho",        "-fill_holes",       "-threads", "-bucket_points", "-grid",       "-viewpoint",
+      "-time_limit", "-estimate_normals", "-initial", "-initial_mode",  "-medial_axis"};
   std::vector<std::string> positional;
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
@@ -194,6 +197,7 @@ bool parseReconstructArguments(int argc, char **argv, ReconstructOptions &option
       return false;
     }
   }
+  pcl::console::parse_argument(argc, argv, "-medial_axis", options.medial_axis);
 
   if (positional.size() != 2) {
     error = "expected input and output file names, got " + std::to_string(positional.size()) +
@@ -217,6 +221,7 @@ std::string reconstructParameters(const ReconstructOptions &options,
     parameters.viewpoint = {{options.viewpoint[0], options.viewpoint[1], options.viewpoint[2]}};
   parameters.time_limit_seconds = options.time_limit;
   parameters.initial_triangles_mode = options.initial_mode;
+  parameters.compute_medial_axis = !options.medial_axis.empty();
   return parameters.validate();
 }
 
@@ -231,6 +236,45 @@ int checkMeshOutput(const std::string &output, std::string &error) {
   if (!output_dir.empty() && !std::filesystem::is_directory(output_dir, code)) {
     error = output + ": directory " + output_dir.string() + " does not exist";
     return kIoFailure;
+  }
+  return kSuccess;
+}
+
+int checkMedialAxisOutput(const std::string &path, std::string &error) {
+  if (path.empty())
+    return kSuccess;
+  if (pcl_ms::fileExtension(path) != ".ply") {
+    error = path + ": the medial axis is written as .ply only";
+    return kBadArguments;
+  }
+  const std::filesystem::path directory = std::filesystem::path(path).parent_path();
+  std::error_code code;
+  if (!directory.empty() && !std::filesystem::is_directory(directory, code)) {
+    error = path + ": directory " + directory.string() + " does not exist";
+    return kIoFailure;
+  }
+  return kSuccess;
+}
+
+int saveReconstructedMedialAxis(const ReconstructOptions &options, const pcl_ms::Result &result,
+                                std::string &error) {
+  if (options.medial_axis.empty())
+    return kSuccess;
+  const pcl_ms::MedialAxis none;
+  const pcl_ms::MedialAxis &axis = result.medial_axis ? *result.medial_axis : none;
+  const bool verbose = !options.quiet;
+  double save_ms = 0;
+  if (!fileStep("Saving", options.medial_axis, verbose, save_ms,
+                [&] { return pcl_ms::saveMedialAxis(options.medial_axis, axis, error); }))
+    return kIoFailure;
+  if (verbose) {
+    print_info("[done, ");
+    print_value("%.1f", save_ms);
+    print_info(" ms : ");
+    print_value("%zu", axis.node_positions.size());
+    print_info(" medial axis nodes, ");
+    print_value("%zu", axis.curves.size());
+    print_info(" curves]\n");
   }
   return kSuccess;
 }
@@ -408,6 +452,8 @@ void printReconstructReport(const pcl_ms::Result &result, double load_ms, double
   printRow("scaffold", "%10.1f", timings.scaffold * 1e3);
   printRow("greedy", "%10.1f", timings.greedy * 1e3);
   printRow("finish", "%10.1f", timings.finish * 1e3);
+  if (result.medial_axis)
+    printRow("medial axis", "%10.1f", timings.medial_axis * 1e3);
   printRow("total (reconstruction)", "%10.1f", timings.total * 1e3);
   printRow("save", "%10.1f", save_ms);
 

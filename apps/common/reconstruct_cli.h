@@ -32,6 +32,7 @@ struct ReconstructOptions {
   double time_limit = 0; // seconds, 0: none
   std::string initial;   // a mesh whose triangles start the surface, or empty
   pcl_ms::InitialTrianglesMode initial_mode = pcl_ms::InitialTrianglesMode::fixed;
+  std::string medial_axis; // .ply for the medial axis; empty: not computed
   bool quiet = false;
   bool keep_layout = false; // write the cloud's points as they are, NaN rows too
   bool help = false;
@@ -52,6 +53,14 @@ std::string reconstructParameters(const ReconstructOptions &options,
 /// kSuccess, or the exit code for an output path that cannot be written
 /// (checked before spending time on the reconstruction), with `error` set.
 int checkMeshOutput(const std::string &output, std::string &error);
+
+/// As checkMeshOutput, for the -medial_axis file (kSuccess when none).
+int checkMedialAxisOutput(const std::string &path, std::string &error);
+
+/// Saves the result's medial axis to options.medial_axis with the "Saving"
+/// line; kSuccess (also when none was asked for) or kIoFailure.
+int saveReconstructedMedialAxis(const ReconstructOptions &options, const pcl_ms::Result &result,
+                                std::string &error);
 
 /// Loads the input, prints the PCL-style "Loading" line and applies the
 /// file's viewpoint rule; kSuccess or an exit code with `error` set.

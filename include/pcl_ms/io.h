@@ -53,6 +53,12 @@ bool isMeshOutputSupported(const std::string &path);
 bool saveMesh(const std::string &path, const pcl::PolygonMesh &mesh, std::string &error,
               bool binary = true);
 
+/// Saves a medial axis as .ply: element vertex (float x, y, z, radius and
+/// uchar inside: MedialAxis::Side) and element edge (int vertex1, vertex2),
+/// binary unless `binary` is false. On failure no partial file is left.
+bool saveMedialAxis(const std::string &path, const MedialAxis &axis, std::string &error,
+                    bool binary = true);
+
 /// True when the cloud has FLOAT32 fields normal_x, normal_y and normal_z.
 bool hasNormals(const pcl::PCLPointCloud2 &cloud);
 

@@ -158,6 +158,21 @@ public:
     return parameters_.initial_triangles_mode;
   }
 
+  /** \brief Also compute the medial axis the surface leaves (default off;
+   * it costs a second Delaunay triangulation, nothing when off). */
+  void setComputeMedialAxis(bool compute) { parameters_.compute_medial_axis = compute; }
+  bool getComputeMedialAxis() const { return parameters_.compute_medial_axis; }
+
+  /** \brief The medial axis of the last reconstruct() when
+   * setComputeMedialAxis(true) was set, else empty: node positions (input
+   * coordinates), ball radii, a side per node (pcl_ms::MedialAxis::Side:
+   * inside or outside a closed component, or open) and curves as pairs of
+   * node indices. */
+  const pcl_ms::MedialAxis &getMedialScaffold() const {
+    static const pcl_ms::MedialAxis none;
+    return result_.medial_axis ? *result_.medial_axis : none;
+  }
+
   /** \brief All parameters at once (core struct). */
   void setParameters(const pcl_ms::Parameters &parameters) { parameters_ = parameters; }
   const pcl_ms::Parameters &getParameters() const { return parameters_; }

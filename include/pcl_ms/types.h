@@ -3,6 +3,8 @@
 // types: points come in as strided float arrays, triangles go out as indices.
 #pragma once
 
+#include <Eigen/Core>
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -39,6 +41,28 @@ enum class InitialTrianglesMode : std::uint8_t {
   /// Accepted first, cost 0, but undone like any other candidate when they
   /// conflict; duplicates are merged, invalid and oversize ones left out.
   preferred
+};
+
+/// The medial axis that the surface leaves: the A1^4 nodes (Voronoi vertices
+/// of the points) that are poles with wide contacts, and the A1^3 shock
+/// curves (Voronoi edges) joining two of them whose Delaunay triangle is not
+/// in the surface
+/// (docs/algorithm.md, "Medial axis output"). Plain arrays, one entry per node.
+struct MedialAxis {
+  /// Where a node lies relative to the reconstructed surface.
+  enum Side : std::uint8_t {
+    outside = 0, ///< outside every closed component, away from open ones
+    inside = 1,  ///< enclosed by a closed component of the surface
+    open = 2     ///< reachable from outside past an open component: no side
+  };
+  /// Node positions in the user's coordinates.
+  std::vector<Eigen::Vector3d> node_positions;
+  /// Radius of the maximal ball at each node (the tetrahedron's circumradius).
+  std::vector<double> node_radii;
+  /// A Side per node.
+  std::vector<std::uint8_t> node_side;
+  /// Shock curves as pairs of node indices, the smaller first, sorted.
+  std::vector<std::array<std::uint32_t, 2>> curves;
 };
 
 /// All tuning knobs of the method (docs/algorithm.md).
@@ -88,6 +112,9 @@ struct Parameters {
   std::function<void(std::size_t, std::size_t)> progress;
   /// How initial triangles given to reconstruct() are treated (default fixed).
   InitialTrianglesMode initial_triangles_mode = InitialTrianglesMode::fixed;
+  /// Also compute the medial axis the surface leaves (Result::medial_axis).
+  /// Off by default: it builds a Delaunay triangulation of its own.
+  bool compute_medial_axis = false;
 
   /// Empty when valid, else a one-line reason.
   std::string validate() const;
@@ -119,11 +146,12 @@ struct BucketStatistics {
 /// Wall-clock seconds per stage. In bucketed runs delaunay, scaffold and
 /// greedy are summed over buckets and seams (thread time, not wall clock).
 struct StageTimings {
-  double prepare = 0;  // validation, NaN and duplicate removal
-  double delaunay = 0; // Delaunay tetrahedralisation
-  double scaffold = 0; // candidates, types, costs, candidate graph
-  double greedy = 0;   // passes 1 and 2 with clean-up
-  double finish = 0;   // manifold sweep, holes, orientation, loops
+  double prepare = 0;     // validation, NaN and duplicate removal
+  double delaunay = 0;    // Delaunay tetrahedralisation
+  double scaffold = 0;    // candidates, types, costs, candidate graph
+  double greedy = 0;      // passes 1 and 2 with clean-up
+  double finish = 0;      // manifold sweep, holes, orientation, loops
+  double medial_axis = 0; // only when Parameters::compute_medial_axis
   double total = 0;
 };
 
@@ -178,6 +206,8 @@ struct Result {
   /// Distinct initial triangles that are in the output mesh (either mode).
   std::size_t initial_kept = 0;
   BucketStatistics bucket_statistics;
+  /// Only with Parameters::compute_medial_axis (and on process 0).
+  std::optional<MedialAxis> medial_axis;
   StageTimings timings;
   StagePeakMemory peak_memory;
 
