@@ -977,6 +977,8 @@ TEST_F(App, EstimatedNormalsGuideTheSurface) {
   ASSERT_TRUE(pcl_ms::loadMesh(path("out.ply"), vertices, triangles, error)) << error;
   EXPECT_GT(triangles.size(), 70000u); // the bunny's 35,947 points, closed but for its base
   expectFailure(files + " -estimate_normals 2", "at least 3 neighbours");
+  expectFailure(files + " -estimate_normals 10 -normal_weight -1", "normal weight must be >= 0");
+  expectFailure(files + " -normal_weight x", "-normal_weight");
   expectFailure(files + " -estimate_normals 10 -normals", "exclude each other");
   expectFailure("'" + kDataDir + "/bun0.pcd' '" + path("out.ply") + "' -estimate_normals 10",
                 "already has normals");

@@ -80,6 +80,9 @@ void printReconstructHelp(const char *program, const char *summary) {
   print_info("  -normals        use the cloud's normal_x/y/z fields to guide the surface\n");
   print_info("  -estimate_normals K  estimate normals from each point's K nearest neighbours\n"
              "                  (PCL's NormalEstimation) and use them as -normals does\n");
+  print_info("  -normal_weight W  how much disagreeing normals raise a triangle's cost (default ");
+  print_value("%g", pcl_ms::Parameters().normal_weight);
+  print_info(")\n");
   print_info("  -threads N      threads for the parallel stages, 0 = all cores (default ");
   print_value("%d", pcl_ms::Parameters().num_threads);
   print_info(")\n");
@@ -117,8 +120,9 @@ void printReconstructHelp(const char *program, const char *summary) {
 bool parseReconstructArguments(int argc, char **argv, ReconstructOptions &options,
                                std::string &error) {
   const std::vector<std::string> value_options = {
-      "-rho",        "-fill_holes",       "-threads", "-bucket_points", "-grid",       "-viewpoint",
-      "-time_limit", "-estimate_normals", "-initial", "-initial_mode",  "-medial_axis"};
+      "-rho",     "-fill_holes",   "-threads",     "-bucket_points",
+      "-grid",    "-viewpoint",    "-time_limit",  "-estimate_normals",
+      "-initial", "-initial_mode", "-medial_axis", "-normal_weight"};
   std::vector<std::string> positional;
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
@@ -169,7 +173,8 @@ bool parseReconstructArguments(int argc, char **argv, ReconstructOptions &option
     }
   }
   if (!parseNumber("-time_limit", options.time_limit) ||
-      !parseNumber("-estimate_normals", options.estimate_normals))
+      !parseNumber("-estimate_normals", options.estimate_normals) ||
+      !parseNumber("-normal_weight", options.normal_weight))
     return false;
   if (pcl::console::find_argument(argc, argv, "-estimate_normals") >= 0 &&
       options.estimate_normals < 3) {
@@ -214,6 +219,7 @@ std::string reconstructParameters(const ReconstructOptions &options,
   parameters.rho = options.rho;
   parameters.fill_holes_max_edges = options.fill_holes;
   parameters.use_normals = options.normals || options.estimate_normals > 0;
+  parameters.normal_weight = options.normal_weight;
   parameters.num_threads = options.threads;
   parameters.bucket_points = options.bucket_points;
   parameters.grid_buckets = options.grid;

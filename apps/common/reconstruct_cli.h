@@ -24,6 +24,7 @@ struct ReconstructOptions {
   int fill_holes = pcl_ms::Parameters().fill_holes_max_edges;
   bool normals = false;
   int estimate_normals = 0; // neighbours for PCL's normal estimation, 0: none
+  double normal_weight = pcl_ms::Parameters().normal_weight;
   int threads = pcl_ms::Parameters().num_threads;
   unsigned int bucket_points = 0; // 0: automatic
   int grid = 0;
