@@ -5,11 +5,8 @@
 #include <pcl_ms/medial_axis.h>
 #include <pcl_ms/reconstruct.h>
 
-#include <CGAL/Delaunay_triangulation_3.h>
-#include <CGAL/Delaunay_triangulation_cell_base_3.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_cell_base_with_info_3.h>
-#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+#include "indexed_delaunay.h"
+
 #include <CGAL/constructions/kernel_ftC3.h>
 
 #include <algorithm>
@@ -23,16 +20,11 @@
 namespace pcl_ms {
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using KernelPoint = Kernel::Point_3;
-using VertexBase = CGAL::Triangulation_vertex_base_with_info_3<VertexIndex, Kernel>;
-using CellBase =
-    CGAL::Triangulation_cell_base_with_info_3<std::uint32_t, Kernel,
-                                              CGAL::Delaunay_triangulation_cell_base_3<Kernel>>;
-using DataStructure = CGAL::Triangulation_data_structure_3<VertexBase, CellBase>;
-using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, DataStructure>;
-using CellHandle = Delaunay::Cell_handle;
-using VertexHandle = Delaunay::Vertex_handle;
+using detail::CellHandle;
+using detail::Delaunay;
+using detail::Kernel;
+using detail::KernelPoint;
+using detail::VertexHandle;
 
 constexpr std::uint32_t no_cell = std::numeric_limits<std::uint32_t>::max();
 

@@ -4,13 +4,8 @@
 #include <pcl_ms/scaffold.h>
 
 #include "flat_cells.h"
+#include "indexed_delaunay.h"
 #include "threads.h"
-
-#include <CGAL/Delaunay_triangulation_3.h>
-#include <CGAL/Delaunay_triangulation_cell_base_3.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_cell_base_with_info_3.h>
-#include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
 #include <tbb/parallel_for.h>
 
@@ -24,16 +19,11 @@
 namespace pcl_ms {
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using KernelPoint = Kernel::Point_3;
-using VertexBase = CGAL::Triangulation_vertex_base_with_info_3<VertexIndex, Kernel>;
-using CellBase =
-    CGAL::Triangulation_cell_base_with_info_3<std::uint32_t, Kernel,
-                                              CGAL::Delaunay_triangulation_cell_base_3<Kernel>>;
-using DataStructure = CGAL::Triangulation_data_structure_3<VertexBase, CellBase>;
-using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, DataStructure>;
-using CellHandle = Delaunay::Cell_handle;
-using VertexHandle = Delaunay::Vertex_handle;
+using detail::CellHandle;
+using detail::Delaunay;
+using detail::Kernel;
+using detail::KernelPoint;
+using detail::VertexHandle;
 
 // Cells per unit of parallel work. Chunks are fixed ranges of the cell order,
 // so the output does not depend on how many threads process them.

@@ -176,6 +176,13 @@ TEST(MedialAxis, OffByDefaultAndTheMeshIsTheSameEitherWay) {
   EXPECT_EQ(on.boundary_loops, off.boundary_loops);
 }
 
+void expectSameAxis(const MedialAxis &actual, const MedialAxis &expected) {
+  EXPECT_EQ(actual.node_positions, expected.node_positions);
+  EXPECT_EQ(actual.node_radii, expected.node_radii);
+  EXPECT_EQ(actual.node_side, expected.node_side);
+  EXPECT_EQ(actual.curves, expected.curves);
+}
+
 TEST(MedialAxis, SameAxisWhateverThePointOrder) {
   const std::vector<float> xyz = randomTorus(4000, 1.0, 0.3, 11);
   const pcl_ms::Result result = pcl_ms::reconstruct(viewOf(xyz), pcl_ms::Parameters());
@@ -191,10 +198,7 @@ TEST(MedialAxis, SameAxisWhateverThePointOrder) {
       v = count - 1 - v;
   const MedialAxis reversed = pcl_ms::computeMedialAxis(points, renumbered);
   EXPECT_GT(axis.node_positions.size(), 0u);
-  EXPECT_EQ(reversed.node_positions, axis.node_positions);
-  EXPECT_EQ(reversed.node_radii, axis.node_radii);
-  EXPECT_EQ(reversed.node_side, axis.node_side);
-  EXPECT_EQ(reversed.curves, axis.curves);
+  expectSameAxis(reversed, axis);
 }
 
 TEST(MedialAxis, SameFromReconstructWhateverTheOrderAndThreads) {
@@ -208,10 +212,7 @@ TEST(MedialAxis, SameFromReconstructWhateverTheOrderAndThreads) {
   parameters.num_threads = 2;
   const MedialAxis other = *pcl_ms::reconstruct(viewOf(reversed), parameters).medial_axis;
   EXPECT_GT(one.node_positions.size(), 0u);
-  EXPECT_EQ(other.node_positions, one.node_positions);
-  EXPECT_EQ(other.node_radii, one.node_radii);
-  EXPECT_EQ(other.node_side, one.node_side);
-  EXPECT_EQ(other.curves, one.curves);
+  expectSameAxis(other, one);
 }
 
 TEST(MedialAxis, OpenSurfaceGivesNoInside) {

@@ -231,19 +231,24 @@ std::string reconstructParameters(const ReconstructOptions &options,
   return parameters.validate();
 }
 
+/// kSuccess, or kIoFailure when the directory `path` would be written in is missing.
+int checkOutputDirectory(const std::string &path, std::string &error) {
+  const std::filesystem::path directory = std::filesystem::path(path).parent_path();
+  std::error_code code;
+  if (!directory.empty() && !std::filesystem::is_directory(directory, code)) {
+    error = path + ": directory " + directory.string() + " does not exist";
+    return kIoFailure;
+  }
+  return kSuccess;
+}
+
 int checkMeshOutput(const std::string &output, std::string &error) {
   if (!pcl_ms::isMeshOutputSupported(output)) {
     error = output + ": output format '" + pcl_ms::fileExtension(output) +
             "' is not supported (use .ply, .vtk or .obj)";
     return kBadArguments;
   }
-  const std::filesystem::path output_dir = std::filesystem::path(output).parent_path();
-  std::error_code code;
-  if (!output_dir.empty() && !std::filesystem::is_directory(output_dir, code)) {
-    error = output + ": directory " + output_dir.string() + " does not exist";
-    return kIoFailure;
-  }
-  return kSuccess;
+  return checkOutputDirectory(output, error);
 }
 
 int checkMedialAxisOutput(const std::string &path, std::string &error) {
@@ -253,13 +258,7 @@ int checkMedialAxisOutput(const std::string &path, std::string &error) {
     error = path + ": the medial axis is written as .ply only";
     return kBadArguments;
   }
-  const std::filesystem::path directory = std::filesystem::path(path).parent_path();
-  std::error_code code;
-  if (!directory.empty() && !std::filesystem::is_directory(directory, code)) {
-    error = path + ": directory " + directory.string() + " does not exist";
-    return kIoFailure;
-  }
-  return kSuccess;
+  return checkOutputDirectory(path, error);
 }
 
 int saveReconstructedMedialAxis(const ReconstructOptions &options, const pcl_ms::Result &result,
