@@ -23,7 +23,8 @@ struct ReconstructOptions {
   double rho = pcl_ms::Parameters().rho;
   int fill_holes = pcl_ms::Parameters().fill_holes_max_edges;
   bool normals = false;
-  int estimate_normals = 0; // neighbours for PCL's normal estimation, 0: none
+  bool non_manifold = false; // seams: -non_manifold
+  int estimate_normals = 0;  // neighbours for PCL's normal estimation, 0: none
   int threads = pcl_ms::Parameters().num_threads;
   unsigned int bucket_points = 0; // 0: automatic
   int grid = 0;
