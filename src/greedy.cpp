@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <numeric>
+#include <queue>
 #include <unordered_map>
 
 namespace pcl_ms {
@@ -152,6 +154,21 @@ constexpr double swap_angle_tolerance = 1e-9;
 // before: smooth surfaces bend a little either way.
 constexpr double smooth_bending_angle = 0.35;
 
+// Seam pass (docs/algorithm.md, "Seams (opt-in)"): a triangle may join an
+// edge that holds two already when its bending angles to them all lie in
+// these bounds: not a flat continuation of one sheet (below), not folded
+// back onto one (above).
+constexpr double min_seam_bending = 0.2;
+constexpr double max_seam_bending = 2.9;
+// Seam-pass triangles grow sheets: across an edge with one triangle they
+// must continue it smoothly (about 29 degrees at most), or they would bridge
+// the wedge between two sheets meeting at the seam.
+constexpr double max_sheet_bending = 0.5;
+// A seam triangle's longest side is at most this times the longest side of
+// the triangles on its full edge: on the test clouds the right ones measured
+// 0.78-1.14 times, triangles bridging the wedge between two sheets 1.6-2.2.
+constexpr double max_seam_size_ratio = 1.4;
+
 } // namespace
 
 class GreedyMesher::Impl {
@@ -188,6 +205,16 @@ public:
     runPass(State::queue2, statistics_.pass2);
     swapNonDelaunayDiagonals();
     enforceManifoldVertices();
+    if (parameters_.allow_non_manifold)
+      runSeamPass();
+  }
+
+  std::vector<Triangle> seamTriangles() const {
+    std::vector<Triangle> result;
+    result.reserve(seam_list_.size());
+    for (CandidateIndex t : seam_list_)
+      result.push_back(candidates_[t].vertices);
+    return result;
   }
 
   std::vector<Triangle> triangles(bool with_fixed) const {
@@ -830,6 +857,174 @@ private:
     unnumbered_ = {};
   }
 
+  // ---- seams (opt-in) --------------------------------------------------------
+
+  /// Calls visit(u) for every triangle on edge e: the mesh's, then the seam
+  /// pass's, which are kept outside MeshTopology (it holds two per edge).
+  template <typename Visit> void forEachOccupant(EdgeIndex e, const Visit &visit) const {
+    for (CandidateIndex u : mesh_.edgeTriangles(e))
+      if (u != no_candidate)
+        visit(u);
+    const auto found = seam_on_edge_.find(e);
+    if (found != seam_on_edge_.end())
+      for (CandidateIndex u : found->second)
+        visit(u);
+  }
+
+  std::size_t edgeUses(EdgeIndex e) const {
+    const auto found = seam_on_edge_.find(e);
+    return static_cast<std::size_t>(mesh_.edgeTriangleCount(e)) +
+           (found == seam_on_edge_.end() ? 0 : found->second.size());
+  }
+
+  enum class SeamFit { none, seam, filler };
+
+  /// Whether t may join in the seam pass: as a *seam* triangle, on one edge
+  /// that holds two or more triangles, bending to each of them within the
+  /// bounds, and attached to a sheet (an edge with one triangle, or its apex
+  /// on a sheet's rim along that sheet: the third sheet grows from its rim);
+  /// or as a *filler* that closes the gap between a seam triangle and a
+  /// sheet (two edges with one triangle each, one of them a seam triangle's).
+  /// Across edges with one triangle, t must continue that sheet smoothly.
+  SeamFit seamFit(CandidateIndex t) const {
+    const Candidate &candidate = candidates_[t];
+    // Only Gabriel triangles (types I, II): type III ones bridged the wedge
+    // between sheets on the test clouds.
+    if (mesh_.contains(t) || is_seam_[t] || candidate.type == CandidateType::ambiguous)
+      return SeamFit::none;
+    int full = 0, attached = 0, full_slot = 0;
+    bool next_to_seam_triangle = false;
+    for (int k = 0; k < 3; ++k) {
+      const EdgeIndex e = candidate.edges[k];
+      const std::size_t uses = edgeUses(e);
+      const VertexIndex p = candidate.vertices[k], q = candidate.vertices[(k + 1) % 3];
+      const VertexIndex apex = candidate.vertices[(k + 2) % 3];
+      bool fits = true;
+      forEachOccupant(e, [&](CandidateIndex u) {
+        const double angle =
+            bendingAngle(points_[p], points_[q], points_[apex], points_[apexOf(u, p, q)]);
+        if (uses >= 2 ? angle < min_seam_bending || angle > max_seam_bending
+                      : angle > max_sheet_bending)
+          fits = false;
+        next_to_seam_triangle |= is_seam_[u];
+      });
+      if (!fits)
+        return SeamFit::none;
+      if (uses >= 2) {
+        ++full;
+        full_slot = k;
+      }
+      attached += uses == 1;
+    }
+    if (full > 1)
+      return SeamFit::none;
+    if (full == 1 &&
+        longestSide(t) > max_seam_size_ratio * longestOnEdge(candidate.edges[full_slot]))
+      return SeamFit::none;
+    if (full == 1)
+      return attached > 0 || continuesSheetAt(t, candidate.vertices[(full_slot + 2) % 3])
+                 ? SeamFit::seam
+                 : SeamFit::none;
+    return attached >= 2 && next_to_seam_triangle ? SeamFit::filler : SeamFit::none;
+  }
+
+  double longestSide(CandidateIndex t) const {
+    const auto &v = candidates_[t].vertices;
+    return std::sqrt(std::max({(points_[v[0]] - points_[v[1]]).squaredNorm(),
+                               (points_[v[1]] - points_[v[2]]).squaredNorm(),
+                               (points_[v[2]] - points_[v[0]]).squaredNorm()}));
+  }
+
+  /// The longest side among the triangles on edge e.
+  double longestOnEdge(EdgeIndex e) const {
+    double longest = 0;
+    forEachOccupant(e, [&](CandidateIndex u) { longest = std::max(longest, longestSide(u)); });
+    return longest;
+  }
+
+  /// Whether t lies along a sheet whose rim passes through its corner v: v
+  /// is on a boundary edge of the mesh and one of its triangles is within
+  /// max_sheet_bending of t's plane.
+  bool continuesSheetAt(CandidateIndex t, VertexIndex v) const {
+    if (mesh_.vertexBoundaryEdges(v) == 0)
+      return false;
+    const auto normal = [&](const Triangle &corners) {
+      return (points_[corners[1]] - points_[corners[0]])
+          .cross(points_[corners[2]] - points_[corners[0]])
+          .normalized();
+    };
+    const Eigen::Vector3d own = normal(candidates_[t].vertices);
+    for (CandidateIndex u : mesh_.vertexTriangles(v))
+      if (std::abs(own.dot(normal(candidates_[u].vertices))) >= std::cos(max_sheet_bending))
+        return true;
+    return false;
+  }
+
+  /// Base cost plus the context of every triangle already on t's edges.
+  float seamCost(CandidateIndex t) const {
+    double context = 0;
+    for (EdgeIndex e : candidates_[t].edges)
+      forEachOccupant(e, [&](CandidateIndex u) {
+        for (int k = 0; k < 3; ++k)
+          if (candidates_[u].edges[k] == e)
+            context += contextTerm(u, k, t);
+      });
+    return static_cast<float>(std::max(0.0, candidates_[t].base_cost + context));
+  }
+
+  /// The third queue (paper Fig. 18): after pass 2 and the manifold sweep,
+  /// candidates that fit (seamFit) are accepted cheapest first; each one
+  /// accepted brings the candidates at its corners in again.
+  void runSeamPass() {
+    const std::size_t count = candidates_.size();
+    is_seam_.assign(count, false);
+    // Candidates by corner, to find those a new seam triangle affects: the
+    // Gabriel ones (seamFit), which all have their edges numbered.
+    auto listed = [&](CandidateIndex t) {
+      return !mesh_.contains(t) && candidates_[t].type != CandidateType::ambiguous;
+    };
+    std::vector<std::uint32_t> offsets(points_.size() + 1, 0);
+    for (CandidateIndex t = 0; t < count; ++t)
+      if (listed(t))
+        for (VertexIndex v : candidates_[t].vertices)
+          ++offsets[v + 1];
+    std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+    std::vector<CandidateIndex> at_vertex(offsets.back());
+    std::vector<std::uint32_t> cursor(offsets.begin(), offsets.end() - 1);
+    for (CandidateIndex t = 0; t < count; ++t)
+      if (listed(t))
+        for (VertexIndex v : candidates_[t].vertices)
+          at_vertex[cursor[v]++] = t;
+
+    using Entry = std::pair<float, CandidateIndex>;
+    std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap;
+    for (CandidateIndex t = 0; t < count; ++t)
+      if (listed(t) && seamFit(t) != SeamFit::none)
+        heap.emplace(seamCost(t), t);
+    while (!heap.empty()) {
+      const auto [cost, t] = heap.top();
+      heap.pop();
+      if (deadline_)
+        deadline_->checkEvery(deadline_counter_, "the seam pass");
+      if (is_seam_[t] || seamFit(t) == SeamFit::none)
+        continue;
+      const float current = seamCost(t);
+      if (current != cost) { // its context changed since it was queued
+        heap.emplace(current, t);
+        continue;
+      }
+      is_seam_[t] = true;
+      seam_list_.push_back(t);
+      ++statistics_.seam_triangles;
+      for (EdgeIndex e : candidates_[t].edges)
+        seam_on_edge_[e].push_back(t);
+      for (VertexIndex v : candidates_[t].vertices)
+        for (std::uint32_t i = offsets[v]; i < offsets[v + 1]; ++i)
+          if (seamFit(at_vertex[i]) != SeamFit::none)
+            heap.emplace(seamCost(at_vertex[i]), at_vertex[i]);
+    }
+  }
+
   // ---- clean-up ------------------------------------------------------------
 
   void removeFlapsAndIsolatedTriangles() {
@@ -954,6 +1149,10 @@ private:
   std::unordered_map<EdgeIndex, std::vector<CandidateIndex>> swapped_in_;
   std::vector<std::uint32_t> unnumbered_offsets_; // by lowest vertex, during swaps
   std::vector<CandidateIndex> unnumbered_;
+  // Seam pass: its triangles in order, per edge, and flags.
+  std::vector<CandidateIndex> seam_list_;
+  std::unordered_map<EdgeIndex, std::vector<CandidateIndex>> seam_on_edge_;
+  std::vector<bool> is_seam_;
   CandidateQueue queues_[2];       // Q1, Q2
   std::size_t queued_[2] = {0, 0}; // candidates whose state is that queue
   bool queue2_built_ = false;
@@ -971,5 +1170,7 @@ void GreedyMesher::run() { impl_->run(); }
 std::vector<Triangle> GreedyMesher::triangles(bool with_fixed) const {
   return impl_->triangles(with_fixed);
 }
+
+std::vector<Triangle> GreedyMesher::seamTriangles() const { return impl_->seamTriangles(); }
 
 } // namespace pcl_ms

@@ -368,7 +368,9 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
       parameters.use_normals ? &prepared.normals : nullptr;
 
   std::vector<Triangle> triangles;
-  std::vector<float> local_scale; // per distinct point
+  std::vector<Triangle> seam_triangles;   // Parameters::allow_non_manifold
+  std::vector<Triangle> greedy_triangles; // what the finish starts from, with seams
+  std::vector<float> local_scale;         // per distinct point
   // Initial triangles are honoured by the one-piece path only.
   const bool in_buckets =
       initial_triangles.empty() && usesBuckets(prepared.positions.size(), parameters);
@@ -423,6 +425,9 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
     GreedyMesher mesher(scaffold, prepared.positions, parameters, &deadline);
     mesher.run();
     triangles = mesher.triangles();
+    seam_triangles = mesher.seamTriangles();
+    if (!seam_triangles.empty())
+      greedy_triangles = triangles;
     local_scale = std::move(scaffold.local_scale);
     result.pass1 = mesher.statistics().pass1;
     result.pass2 = mesher.statistics().pass2;
@@ -458,6 +463,12 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
                       SideLimit{&local_scale, parameters.rho},
                       anchored.empty() ? nullptr : &anchored, viewpoint ? &*viewpoint : nullptr);
   });
+  std::vector<std::array<VertexIndex, 2>> seam_edges;
+  if (!seam_triangles.empty()) {
+    const std::size_t before = surface.triangles.size();
+    seam_edges = attachSeamTriangles(surface, seam_triangles, greedy_triangles);
+    result.seam_triangles = surface.triangles.size() - before;
+  }
   deadline.check("the finish");
   if (!fixed.empty() || !preferred.empty())
     result.initial_kept = countKept(fixed.empty() ? preferred : fixed, surface.triangles);
@@ -481,6 +492,13 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
   for (auto &loop : surface.boundary_loops)
     for (VertexIndex &v : loop)
       v = prepared.user_index[v];
+  for (auto &edge : seam_edges) {
+    edge = {prepared.user_index[edge[0]], prepared.user_index[edge[1]]};
+    if (edge[0] > edge[1])
+      std::swap(edge[0], edge[1]);
+  }
+  std::sort(seam_edges.begin(), seam_edges.end());
+  result.seam_edges = std::move(seam_edges);
   result.triangles = std::move(surface.triangles);
   result.boundary_loops = std::move(surface.boundary_loops);
   result.triangle_component = std::move(surface.triangle_component);

@@ -83,6 +83,8 @@ void printReconstructHelp(const char *program, const char *summary) {
   print_info("  -normal_weight W  how much disagreeing normals raise a triangle's cost (default ");
   print_value("%g", pcl_ms::Parameters().normal_weight);
   print_info(")\n");
+  print_info("  -non_manifold   allow non-manifold seams: a third (fourth...) triangle on an\n"
+             "                  edge where sheets meet (default off: a 2-manifold mesh)\n");
   print_info("  -threads N      threads for the parallel stages, 0 = all cores (default ");
   print_value("%d", pcl_ms::Parameters().num_threads);
   print_info(")\n");
@@ -130,6 +132,8 @@ bool parseReconstructArguments(int argc, char **argv, ReconstructOptions &option
       options.help = true;
     } else if (argument == "-normals") {
       options.normals = true;
+    } else if (argument == "-non_manifold") {
+      options.non_manifold = true;
     } else if (argument == "-q") {
       options.quiet = true;
     } else if (argument == "-no_viewpoint") {
@@ -228,6 +232,7 @@ std::string reconstructParameters(const ReconstructOptions &options,
   parameters.time_limit_seconds = options.time_limit;
   parameters.initial_triangles_mode = options.initial_mode;
   parameters.compute_medial_axis = !options.medial_axis.empty();
+  parameters.allow_non_manifold = options.non_manifold;
   return parameters.validate();
 }
 
@@ -478,6 +483,10 @@ void printReconstructReport(const pcl_ms::Result &result, double load_ms, double
     printRow("initial repeats merged", "%10.0f", static_cast<double>(result.initial_duplicates));
     printRow("initial invalid", "%10.0f", static_cast<double>(result.initial_invalid));
     printRow("initial oversize", "%10.0f", static_cast<double>(result.initial_oversize));
+  }
+  if (result.seam_triangles > 0 || !result.seam_edges.empty()) {
+    printRow("seam triangles", "%10.0f", static_cast<double>(result.seam_triangles));
+    printRow("seam edges", "%10.0f", static_cast<double>(result.seam_edges.size()));
   }
   print_info("  %-22s", "components");
   print_value("%10zu", result.numberOfComponents());

@@ -25,6 +25,7 @@ struct ReconstructOptions {
   bool normals = false;
   int estimate_normals = 0; // neighbours for PCL's normal estimation, 0: none
   double normal_weight = pcl_ms::Parameters().normal_weight;
+  bool non_manifold = false; // seams: -non_manifold
   int threads = pcl_ms::Parameters().num_threads;
   unsigned int bucket_points = 0; // 0: automatic
   int grid = 0;

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -53,5 +54,17 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
                               const SideLimit &limit,
                               const std::vector<bool> *anchored_vertices = nullptr,
                               const Eigen::Vector3d *viewpoint = nullptr);
+
+/// The seam pass's triangles (docs/algorithm.md, "Seams (opt-in)") join a
+/// surface finished from the greedy's `greedy` triangles: exact repeats and
+/// those on an edge where the finish added a triangle are left out, each new
+/// triangle takes the orientation of its sheet across edges with two
+/// triangles (the finished ones keep theirs), components become the
+/// manifold sheets (joined across edges with exactly two triangles) and
+/// boundary loops are traced again. Returns the edges with three or more
+/// triangles, smaller vertex first, sorted.
+std::vector<std::array<VertexIndex, 2>> attachSeamTriangles(FinishedSurface &surface,
+                                                            const std::vector<Triangle> &seam,
+                                                            const std::vector<Triangle> &greedy);
 
 } // namespace pcl_ms

@@ -23,6 +23,8 @@ struct GreedyStatistics {
   std::size_t cleanup_undone = 0;
   /// Pairs of triangles replaced by the other diagonal's pair.
   std::size_t swapped_pairs = 0;
+  /// Triangles the seam pass accepted (Parameters::allow_non_manifold).
+  std::size_t seam_triangles = 0;
 };
 
 class GreedyMesher {
@@ -37,13 +39,18 @@ public:
   GreedyMesher &operator=(const GreedyMesher &) = delete;
 
   /// Pass 1 (types I, II), clean-up, pass 2 (type III and demoted), then
-  /// the final sweep that guarantees a 2-manifold result. The scaffold's
+  /// the final sweep that guarantees a 2-manifold result; then, with
+  /// Parameters::allow_non_manifold, the seam pass (seamTriangles). The scaffold's
   /// fixed triangles are in the mesh from the start and never undone.
   void run();
 
   /// Accepted triangles as distinct-point indices, in candidate order;
   /// without the scaffold's fixed triangles when `with_fixed` is false.
   std::vector<Triangle> triangles(bool with_fixed = true) const;
+  /// With Parameters::allow_non_manifold, the triangles of the seam pass
+  /// (docs/algorithm.md, "Seams (opt-in)"), kept apart from triangles(): the
+  /// 2-manifold mesh is finished first and these join it afterwards.
+  std::vector<Triangle> seamTriangles() const;
   const GreedyStatistics &statistics() const { return statistics_; }
 
 private:

@@ -65,6 +65,14 @@ public:
   void setUseNormals(bool use) { parameters_.use_normals = use; }
   bool getUseNormals() const { return parameters_.use_normals; }
 
+  /** \brief Non-manifold seams (default off): after pass 2, a third pass may
+   * put a third (fourth...) triangle on an edge where sheets meet, when it
+   * bends to the triangles there by 0.2-2.9 rad; orientation is then per
+   * manifold sheet and the result's seam_edges lists those edges. Off, the
+   * output is 2-manifold. Honoured when the cloud is meshed in one piece. */
+  void setAllowNonManifold(bool allow) { parameters_.allow_non_manifold = allow; }
+  bool getAllowNonManifold() const { return parameters_.allow_non_manifold; }
+
   /** \brief Weight kappa of the normal term (default 1). Must be >= 0. */
   void setNormalWeight(double kappa) { parameters_.normal_weight = kappa; }
   double getNormalWeight() const { return parameters_.normal_weight; }

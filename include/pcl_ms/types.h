@@ -115,6 +115,11 @@ struct Parameters {
   /// Also compute the medial axis the surface leaves (Result::medial_axis).
   /// Off by default: it builds a Delaunay triangulation of its own.
   bool compute_medial_axis = false;
+  /// Non-manifold seams (docs/algorithm.md, "Seams (opt-in)"): after pass 2 a
+  /// third pass may put a third (fourth...) triangle on an edge where sheets
+  /// meet. Off by default: the output is then 2-manifold. One-piece runs only
+  /// (a bucketed run ignores it).
+  bool allow_non_manifold = false;
 
   /// Empty when valid, else a one-line reason.
   std::string validate() const;
@@ -205,6 +210,11 @@ struct Result {
   std::size_t initial_duplicates = 0, initial_invalid = 0, initial_oversize = 0;
   /// Distinct initial triangles that are in the output mesh (either mode).
   std::size_t initial_kept = 0;
+  /// With Parameters::allow_non_manifold: the edges that hold three or more
+  /// triangles (user indices, smaller first, sorted), and the triangles the
+  /// seam pass added (they are in `triangles` too).
+  std::vector<std::array<VertexIndex, 2>> seam_edges;
+  std::size_t seam_triangles = 0;
   BucketStatistics bucket_statistics;
   /// Only with Parameters::compute_medial_axis (and on process 0).
   std::optional<MedialAxis> medial_axis;
