@@ -1,0 +1,103 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Parsing pieces that the file readers share: words and numbers of text
+// formats, whole files and header lines read with limits, and the PLY header.
+// Internal to the library: not installed.
+#pragma once
+
+#include <charconv>
+#include <cstddef>
+#include <cstdint>
+#include <istream>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <vector>
+
+namespace pcl_ms {
+namespace io_detail {
+
+std::string toLower(std::string text);
+bool isBlank(char c);
+std::string_view trim(std::string_view text);
+std::vector<std::string_view> splitWords(std::string_view text);
+bool startsWith(std::string_view text, std::string_view prefix);
+
+/// The whole token as a number (a leading '+' allowed), nothing else.
+template <typename Number> bool parseNumber(std::string_view token, Number &value) {
+  if (!token.empty() && token.front() == '+')
+    token.remove_prefix(1);
+  if (token.empty())
+    return false;
+  const char *last = token.data() + token.size();
+  const auto [end, code] = std::from_chars(token.data(), last, value);
+  return code == std::errc() && end == last;
+}
+
+inline bool parseDouble(std::string_view token, double &value) { return parseNumber(token, value); }
+
+template <typename Integer> bool parseInteger(std::string_view token, Integer &value) {
+  return parseNumber(token, value);
+}
+
+/// Printable form of a header word for error messages (garbage stays short).
+std::string printable(std::string_view word);
+/// True when `value` is a whole number in [low, high]; NaN and infinities are not.
+bool isWholeNumberIn(double value, double low, double high);
+/// A number from a file for an error message, in the shortest form that reads back.
+std::string printableNumber(double value);
+
+/// Checks that `path` names a readable, non-empty regular file.
+bool checkInputFile(const std::string &path, std::uintmax_t &size, std::string &error);
+/// The whole file, after checkInputFile().
+bool readFileBytes(const std::string &path, std::string &bytes, std::string &error);
+/// Reads one header line of at most `max_length` characters (without the
+/// newline). False at end of file or when the line is longer: a binary file
+/// must not make us swallow megabytes looking for a newline.
+bool readHeaderLine(std::istream &in, std::string &line, std::size_t max_length);
+inline constexpr std::size_t kMaxHeaderLine = 4096;
+inline constexpr std::size_t kMaxHeaderLines = 100000;
+
+bool hostIsLittleEndian();
+
+// ---------------------------------------------------------------------------
+// PLY header (used to validate clouds and to read meshes)
+
+enum class PlyFormat { Ascii, BinaryLittleEndian, BinaryBigEndian };
+
+enum class PlyType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
+
+struct PlyProperty {
+  std::string name;
+  bool is_list = false;
+  PlyType count_type = PlyType::UInt8; // lists only
+  PlyType value_type = PlyType::Float32;
+};
+
+struct PlyElement {
+  std::string name;
+  std::uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+struct PlyHeader {
+  PlyFormat format = PlyFormat::Ascii;
+  std::vector<PlyElement> elements;
+  std::uint64_t header_bytes = 0;
+
+  const PlyElement *find(const std::string &name) const {
+    for (const PlyElement &element : elements)
+      if (element.name == name)
+        return &element;
+    return nullptr;
+  }
+};
+
+bool parsePlyType(std::string_view word, PlyType &type);
+std::size_t plyTypeSize(PlyType type);
+bool parsePlyHeader(std::istream &in, PlyHeader &header, std::string &error);
+/// Rejects files shorter than the smallest body their header allows, which
+/// catches truncation and absurd element counts before anything is allocated.
+bool checkPlyBodySize(const PlyHeader &header, std::uintmax_t file_size, std::string &error);
+
+} // namespace io_detail
+} // namespace pcl_ms

@@ -1,0 +1,27 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Mesh readers of our own for .ply, .obj, .off and legacy .vtk, so that every
+// format reports the same kind of errors. Internal to the library: not
+// installed; loadMesh() in io.h is the public entry.
+#pragma once
+
+#include <pcl_ms/types.h>
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace pcl_ms {
+namespace io_detail {
+
+bool loadPlyMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices,
+                 std::vector<Triangle> &triangles, std::string &error);
+bool loadObjMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices,
+                 std::vector<Triangle> &triangles, std::string &error);
+bool loadOffMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices,
+                 std::vector<Triangle> &triangles, std::string &error);
+bool loadVtkMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices,
+                 std::vector<Triangle> &triangles, std::string &error);
+
+} // namespace io_detail
+} // namespace pcl_ms
