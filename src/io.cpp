@@ -392,21 +392,11 @@ bool loadXyzCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::stri
     return false;
 
   std::vector<float> values;
-  std::size_t columns = 0, line_number = 0, position = 0;
-  while (position < bytes.size()) {
-    std::size_t end = bytes.find('\n', position);
-    const bool has_newline = end != std::string::npos;
-    if (!has_newline)
-      end = bytes.size();
-    std::string_view line(bytes.data() + position, end - position);
-    position = end + 1;
-    ++line_number;
-
-    line = line.substr(0, line.find('#'));
-    const std::vector<std::string_view> words = splitWords(line);
-    if (words.empty())
-      continue;
-    const std::string where = "line " + std::to_string(line_number) + ": ";
+  std::size_t columns = 0;
+  WordLines lines(bytes);
+  while (lines.next()) {
+    const std::vector<std::string_view> &words = lines.words();
+    const std::string where = "line " + std::to_string(lines.lineNumber()) + ": ";
     if (columns == 0) {
       if (words.size() != 3 && words.size() != 6) {
         error = where + "expected 3 (x y z) or 6 (x y z nx ny nz) columns, found " +
@@ -415,7 +405,7 @@ bool loadXyzCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::stri
       }
       columns = words.size();
     } else if (words.size() != columns) {
-      const bool truncated = !has_newline && words.size() < columns;
+      const bool truncated = !lines.endsWithNewline() && words.size() < columns;
       error = where + "expected " + std::to_string(columns) + " columns, found " +
               std::to_string(words.size()) + (truncated ? " (file truncated?)" : "");
       return false;

@@ -60,6 +60,23 @@ bool startsWith(std::string_view text, std::string_view prefix) {
 /// A float is rounded once from the text, as a writer's binary copy would be.
 
 /// Printable form of a header word for error messages (garbage stays short).
+bool WordLines::next() {
+  while (position_ < bytes_.size()) {
+    std::size_t end = bytes_.find('\n', position_);
+    ends_with_newline_ = end != std::string_view::npos;
+    if (!ends_with_newline_)
+      end = bytes_.size();
+    const std::string_view line = bytes_.substr(position_, end - position_);
+    position_ = end + 1;
+    ++line_number_;
+    words_ = splitWords(line.substr(0, line.find('#')));
+    if (!words_.empty())
+      return true;
+  }
+  words_.clear();
+  return false;
+}
+
 std::string printable(std::string_view word) {
   std::string out = "'";
   for (char c : word.substr(0, 40))

@@ -39,6 +39,26 @@ template <typename Integer> bool parseInteger(std::string_view token, Integer &v
   return parseNumber(token, value);
 }
 
+/// The lines of a text file that hold words once a '#' comment is cut off,
+/// one at a time (the .xyz, .obj and .off readers).
+class WordLines {
+public:
+  explicit WordLines(std::string_view bytes) : bytes_(bytes) {}
+  /// Moves to the next line with words; false at the end of the bytes.
+  bool next();
+  const std::vector<std::string_view> &words() const { return words_; }
+  /// 1-based, counting every line, blank and comment lines too.
+  std::size_t lineNumber() const { return line_number_; }
+  /// False for a last line that the file ends without a newline.
+  bool endsWithNewline() const { return ends_with_newline_; }
+
+private:
+  std::string_view bytes_;
+  std::size_t position_ = 0, line_number_ = 0;
+  bool ends_with_newline_ = true;
+  std::vector<std::string_view> words_;
+};
+
 /// Printable form of a header word for error messages (garbage stays short).
 std::string printable(std::string_view word);
 /// True when `value` is a whole number in [low, high]; NaN and infinities are not.

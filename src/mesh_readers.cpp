@@ -279,19 +279,10 @@ bool loadObjMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices
   // Faces are checked once all vertices are known: OBJ allows forward references.
   std::vector<std::vector<std::int64_t>> faces;
   std::vector<std::size_t> face_lines;
-  std::size_t position = 0, line_number = 0;
-  while (position < bytes.size()) {
-    std::size_t end = bytes.find('\n', position);
-    if (end == std::string::npos)
-      end = bytes.size();
-    std::string_view line(bytes.data() + position, end - position);
-    position = end + 1;
-    ++line_number;
-    line = line.substr(0, line.find('#'));
-    const std::vector<std::string_view> words = splitWords(line);
-    if (words.empty())
-      continue;
-    const std::string where = "line " + std::to_string(line_number) + ": ";
+  WordLines lines(bytes);
+  while (lines.next()) {
+    const std::vector<std::string_view> &words = lines.words();
+    const std::string where = "line " + std::to_string(lines.lineNumber()) + ": ";
     if (words[0] == "v") {
       Eigen::Vector3d point;
       if (words.size() < 4 || !parseDouble(words[1], point.x()) ||
@@ -314,7 +305,7 @@ bool loadObjMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices
                                     : static_cast<std::int64_t>(vertices.size()) + index);
       }
       faces.push_back(std::move(corners));
-      face_lines.push_back(line_number);
+      face_lines.push_back(lines.lineNumber());
     }
     // Texture coordinates, normals, groups and materials are not needed.
   }
@@ -335,24 +326,10 @@ bool loadOffMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices
     return false;
   // OFF is line oriented: one vertex or face per line, optionally followed by
   // colours, which is why tokens are not read as one flat stream.
-  std::size_t position = 0, line_number = 0;
-  std::vector<std::string_view> words;
-  const auto nextLine = [&]() {
-    while (position < bytes.size()) {
-      std::size_t end = bytes.find('\n', position);
-      if (end == std::string::npos)
-        end = bytes.size();
-      std::string_view line(bytes.data() + position, end - position);
-      position = end + 1;
-      ++line_number;
-      words = splitWords(line.substr(0, line.find('#')));
-      if (!words.empty())
-        return true;
-    }
-    return false;
-  };
+  WordLines lines(bytes);
+  const std::vector<std::string_view> &words = lines.words();
 
-  if (!nextLine()) {
+  if (!lines.next()) {
     error = "the file has no OFF header";
     return false;
   }
@@ -372,7 +349,7 @@ bool loadOffMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices
   // The counts follow the keyword on the same line or on the next one.
   std::size_t counts_at = 1;
   if (words.size() == 1) {
-    if (!nextLine()) {
+    if (!lines.next()) {
       error = "the OFF header has no vertex and face counts";
       return false;
     }
@@ -381,7 +358,7 @@ bool loadOffMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices
   std::uint64_t vertex_count = 0, face_count = 0;
   if (words.size() < counts_at + 2 || !parseInteger(words[counts_at], vertex_count) ||
       !parseInteger(words[counts_at + 1], face_count)) {
-    error = "line " + std::to_string(line_number) + ": malformed OFF counts";
+    error = "line " + std::to_string(lines.lineNumber()) + ": malformed OFF counts";
     return false;
   }
   // Every vertex and face needs a line of at least a few bytes.
@@ -394,39 +371,39 @@ bool loadOffMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices
   vertices.reserve(vertex_count);
   for (std::uint64_t v = 0; v < vertex_count; ++v) {
     Eigen::Vector3d point;
-    if (!nextLine()) {
+    if (!lines.next()) {
       error = "truncated OFF file: " + std::to_string(v) + " of " + std::to_string(vertex_count) +
               " vertices";
       return false;
     }
     if (words.size() < 3 || !parseDouble(words[0], point.x()) ||
         !parseDouble(words[1], point.y()) || !parseDouble(words[2], point.z())) {
-      error = "line " + std::to_string(line_number) + ": malformed vertex";
+      error = "line " + std::to_string(lines.lineNumber()) + ": malformed vertex";
       return false;
     }
     vertices.push_back(point);
   }
   std::vector<std::int64_t> corners;
   for (std::uint64_t f = 0; f < face_count; ++f) {
-    if (!nextLine()) {
+    if (!lines.next()) {
       error = "truncated OFF file: " + std::to_string(f) + " of " + std::to_string(face_count) +
               " faces";
       return false;
     }
     std::size_t size = 0;
     if (!parseInteger(words[0], size) || words.size() < size + 1) {
-      error = "line " + std::to_string(line_number) + ": malformed face";
+      error = "line " + std::to_string(lines.lineNumber()) + ": malformed face";
       return false;
     }
     corners.assign(size, 0);
     for (std::size_t i = 0; i < size; ++i)
       if (!parseInteger(words[i + 1], corners[i])) {
-        error = "line " + std::to_string(line_number) + ": malformed face";
+        error = "line " + std::to_string(lines.lineNumber()) + ": malformed face";
         return false;
       }
     std::string reason;
     if (!addPolygon(corners, vertices.size(), triangles, reason)) {
-      error = "line " + std::to_string(line_number) + ": face " + reason;
+      error = "line " + std::to_string(lines.lineNumber()) + ": face " + reason;
       return false;
     }
   }
