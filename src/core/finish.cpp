@@ -1,4 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+// Stage 4, finishing (docs/algorithm.md section 4). In: the greedy's
+// triangles and the points. Out: a FinishedSurface: bow-ties split, small
+// holes filled, folds cut, components oriented, boundary loops traced.
 #include <pcl_ms/costs.h>
 #include <pcl_ms/finish.h>
 #include <pcl_ms/mesh_topology.h>

@@ -1,4 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+// Stage 3, greedy gap transforms (docs/algorithm.md section 3). In: the
+// scaffold's candidates and the points. Out: an edge-manifold triangle list,
+// accepted cheapest first, with the passes' statistics.
 #include <pcl_ms/costs.h>
 #include <pcl_ms/greedy.h>
 

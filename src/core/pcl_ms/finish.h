@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Stage 5: turning the accepted triangles into a usable surface: holes of up
-// to k edges closed, each component oriented consistently where possible,
-// boundary loops traced. Works on a plain 2-manifold triangle list.
+// Stage 4 (docs/algorithm.md section 4): turning the accepted triangles into a usable surface:
+// holes of up to k edges closed, each component oriented consistently where possible, boundary
+// loops traced. Works on a plain 2-manifold triangle list.
 #pragma once
 
 #include <pcl_ms/local_scale.h>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Stage 4: greedy gap transforms (paper §3; docs/algorithm.md §3). Candidates
+// Stage 3: greedy gap transforms (paper §3; docs/algorithm.md section 3). Candidates
 // are accepted cheapest first under 2-manifold rules; accepted neighbours
 // change the costs; conflicts undo costlier earlier choices.
 #pragma once
