@@ -6,8 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -164,6 +162,11 @@ constexpr double smooth_bending_angle = 0.35;
 // must continue it smoothly (about 29 degrees at most), or they would bridge
 // the wedge between two sheets meeting at the seam.
 constexpr double max_sheet_bending = 0.5;
+// Across an edge with one triangle, a seam-pass triangle may bend up to
+// this much (about 92 degrees): where a seam ends at a box corner, the
+// third sheet's triangle meets the box's crease. Triangles bridging two
+// sheets are left out by seam detection instead.
+constexpr double max_attached_bending = 1.6;
 // A seam triangle's longest side is at most this times the longest side of
 // the triangles on its full edge: on the test clouds the right ones measured
 // 0.78-1.14 times, triangles bridging the wedge between two sheets 1.6-2.2.
@@ -233,15 +236,6 @@ public:
     if (parameters_.allow_non_manifold) {
       runSeamPass();
       setSeamFansApart();
-    }
-    if (std::getenv("PCL_MS_SEAM_DEBUG")) {
-      for (const Triangle &t : triangles(true))
-        std::fprintf(stderr, "T %u %u %u\n", t[0], t[1], t[2]);
-      for (const Triangle &t : seamTriangles())
-        std::fprintf(stderr, "S %u %u %u\n", t[0], t[1], t[2]);
-      for (CandidateIndex t = 0; t < candidates_.size(); ++t)
-        if (!bridges_seam_.empty() && bridges_seam_[t])
-          std::fprintf(stderr, "X %u %u %u\n", candidates_[t].vertices[0], candidates_[t].vertices[1], candidates_[t].vertices[2]);
     }
   }
 
@@ -1029,24 +1023,6 @@ private:
     bridges_seam_.assign(candidates_.size(), false);
     for (CandidateIndex t = 0; t < candidates_.size(); ++t)
       bridges_seam_[t] = !is_fixed_[t] && !is_preferred_[t] && bridgesSeam(t);
-    if (std::getenv("PCL_MS_SEAM_DEBUG")) {
-      for (VertexIndex v = 0; v < points_.size(); ++v)
-        std::fprintf(stderr, "P %u %.9g %.9g %.9g\n", v, points_[v].x(), points_[v].y(),
-                     points_[v].z());
-      for (const auto &[e, seam] : seam_axes_) {
-        VertexIndex high = 0;
-        for (VertexIndex w : candidates_[*scaffold_.edgeBegin(e)].vertices)
-          if (w != seam.low && scaffold_.findEdge(seam.low, w) == e)
-            high = w;
-        std::fprintf(stderr, "SEAM %u %u %zu", seam.low, high, seam.sheets.size());
-        for (float c : seam.costs)
-          std::fprintf(stderr, " %g", c);
-        std::fprintf(stderr, " L %g\n", (points_[high] - points_[seam.low]).norm());
-      }
-      std::fprintf(stderr, "BRIDGING %zu\n",
-                   static_cast<std::size_t>(
-                       std::count(bridges_seam_.begin(), bridges_seam_.end(), true)));
-    }
   }
 
   /// Keeps the likely seam edges (`found`, ascending) that form chains of
@@ -1116,7 +1092,6 @@ private:
     return false;
   }
 
-
   /// Calls visit(u) for every triangle on edge e: the mesh's, then the seam
   /// pass's, which are kept outside MeshTopology (it holds two per edge).
   template <typename Visit> void forEachOccupant(EdgeIndex e, const Visit &visit) const {
@@ -1174,8 +1149,8 @@ private:
         });
       } else {
         forEachOccupant(e, [&](CandidateIndex u) {
-          fits &= bendingAngle(points_[p], points_[q], points_[apex],
-                               points_[apexOf(u, p, q)]) <= max_sheet_bending;
+          fits &= bendingAngle(points_[p], points_[q], points_[apex], points_[apexOf(u, p, q)]) <=
+                  max_attached_bending;
           next_to_seam_triangle |= is_seam_[u];
         });
       }
@@ -1187,18 +1162,19 @@ private:
       }
       attached += uses == 1;
     }
-    if (full > 1)
-      return SeamFit::none;
-    if (full == 1) {
-      // Only on a likely seam edge, up to one triangle per sheet.
-      const auto seam = seam_axes_.find(candidate.edges[full_slot]);
-      if (seam == seam_axes_.end() ||
-          edgeUses(candidate.edges[full_slot]) >= seam->second.sheets.size())
+    // On each full edge (a likely seam edge: checked above) up to one
+    // triangle per sheet, and no larger than the triangles there. Two full
+    // edges: a corner where the seam turns, attached to its sheet.
+    for (int k = 0; k < 3; ++k) {
+      const EdgeIndex e = candidate.edges[k];
+      if (edgeUses(e) < 2)
+        continue;
+      if (edgeUses(e) >= seam_axes_.at(e).sheets.size() ||
+          longestSide(t) > max_seam_size_ratio * longestOnEdge(e))
         return SeamFit::none;
     }
-    if (full == 1 &&
-        longestSide(t) > max_seam_size_ratio * longestOnEdge(candidate.edges[full_slot]))
-      return SeamFit::none;
+    if (full == 2)
+      return attached > 0 ? SeamFit::seam : SeamFit::none;
     if (full == 1)
       return attached > 0 || continuesSheetAt(t, candidate.vertices[(full_slot + 2) % 3])
                  ? SeamFit::seam
