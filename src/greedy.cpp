@@ -1134,13 +1134,14 @@ private:
 
   enum class SeamFit { none, seam, filler };
 
-  /// Whether t may join in the seam pass: as a *seam* triangle, on one edge
-  /// that holds two or more triangles, bending to each of them within the
-  /// bounds, and attached to a sheet (an edge with one triangle, or its apex
-  /// on a sheet's rim along that sheet: the third sheet grows from its rim);
-  /// or as a *filler* that closes the gap between a seam triangle and a
-  /// sheet (two edges with one triangle each, one of them a seam triangle's).
-  /// Across edges with one triangle, t must continue that sheet smoothly.
+  /// Whether t may join in the seam pass: as a *seam* triangle, on one or
+  /// two likely seam edges that hold two or more triangles, in a sheet of
+  /// each that is still free, and attached to a sheet (an edge with one
+  /// triangle, or its apex on a sheet's rim along that sheet: the third
+  /// sheet grows from its rim); or as a *filler* that closes the gap between
+  /// a seam triangle and a sheet (two edges with one triangle each, one of
+  /// them a seam triangle's). It must not bridge a seam, and across edges
+  /// with one triangle it bends at most max_attached_bending.
   SeamFit seamFit(CandidateIndex t) const {
     const Candidate &candidate = candidates_[t];
     // Only Gabriel triangles (types I, II): type III ones bridged the wedge

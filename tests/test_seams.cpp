@@ -208,10 +208,8 @@ TEST(Seams, PclClassOption) {
 
 class AppSeams : public TempDirTest {};
 
-TEST_F(AppSeams, NonManifoldOptionReportsSeams) {
-  const std::string app = std::string(PCL_MS_BINARY_DIR) + "/pcl_ms_reconstruct";
-  ASSERT_TRUE(fs::exists(app)) << app << " was not built";
-  const SeamCloud cloud = threeHalfPlanes();
+/// The cloud as an .xyz file in the test's directory.
+std::string writeXyz(const SeamCloud &cloud, const std::string &file) {
   std::string xyz;
   char line[96];
   for (std::size_t i = 0; i < cloud.xyz.size(); i += 3) {
@@ -219,13 +217,39 @@ TEST_F(AppSeams, NonManifoldOptionReportsSeams) {
                   cloud.xyz[i + 2]);
     xyz += line;
   }
-  writeFile(path("planes.xyz"), xyz);
+  writeFile(file, xyz);
+  return file;
+}
+
+TEST_F(AppSeams, NonManifoldOptionReportsSeams) {
+  const std::string app = std::string(PCL_MS_BINARY_DIR) + "/pcl_ms_reconstruct";
+  ASSERT_TRUE(fs::exists(app)) << app << " was not built";
+  writeXyz(threeHalfPlanes(), path("planes.xyz"));
   const std::string files = quoted(path("planes.xyz")) + " " + quoted(path("out.ply"));
   ASSERT_EQ(runProgram(app, files), 0) << stderr_;
   EXPECT_FALSE(contains(stdout_, "seam edges")) << stdout_;
   ASSERT_EQ(runProgram(app, files + " -non_manifold"), 0) << stderr_;
   EXPECT_TRUE(contains(stdout_, "seam edges")) << stdout_;
   EXPECT_TRUE(contains(stdout_, "seam triangles")) << stdout_;
+  ASSERT_EQ(runProgram(app, "-h"), 0);
+  EXPECT_TRUE(contains(stdout_ + stderr_, "-non_manifold"));
+}
+
+/// pcl_ms_compare -non_manifold runs pcl_ms with seams: its table shows the
+/// option and the 52 seam edges as non-manifold edges (drawn red).
+TEST_F(AppSeams, CompareDrawsSeams) {
+  const std::string app = std::string(PCL_MS_BINARY_DIR) + "/pcl_ms_compare";
+  if (!fs::exists(app))
+    GTEST_SKIP() << app << " was not built (no VTK)";
+  writeXyz(threeHalfPlanes(), path("planes.xyz"));
+  const std::string out = path("compare");
+  ASSERT_EQ(runProgram(app, quoted(path("planes.xyz")) + " -methods pcl_ms -q -non_manifold -out " +
+                                quoted(out)),
+            0)
+      << stderr_;
+  const std::string table = readFile(out + "/results.md");
+  EXPECT_TRUE(contains(table, "non-manifold seams allowed")) << table;
+  EXPECT_TRUE(contains(table, "| non-manifold edges | 52 |")) << table;
   ASSERT_EQ(runProgram(app, "-h"), 0);
   EXPECT_TRUE(contains(stdout_ + stderr_, "-non_manifold"));
 }
