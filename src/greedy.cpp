@@ -158,9 +158,10 @@ constexpr double smooth_bending_angle = 0.35;
 // Seam pass (docs/algorithm.md, "Seams (opt-in)"): a triangle joins a likely
 // seam edge that holds two already only in a sheet of that edge (found
 // before the passes) that no triangle there occupies yet.
-// Seam-pass triangles grow sheets: across an edge with one triangle they
-// must continue it smoothly (about 29 degrees at most), or they would bridge
-// the wedge between two sheets meeting at the seam.
+// Sheets: a point is in a sheet of a seam edge when its direction around the
+// edge is within this (about 29 degrees) of the sheet's, two neighbouring
+// seam edges have the same sheets when these agree within it, and the third
+// sheet grows from a rim whose triangles lie within it of its plane.
 constexpr double max_sheet_bending = 0.5;
 // Across an edge with one triangle, a seam-pass triangle may bend up to
 // this much (about 92 degrees): where a seam ends at a box corner, the
@@ -903,8 +904,8 @@ private:
   struct SeamAxis {
     VertexIndex low = 0, high = 0;
     Eigen::Vector3d axis, across1, across2;
-    std::vector<double> sheets; // ascending angles in [-pi, pi)
-    std::vector<float> costs;
+    std::vector<double> sheets; // angles in [-pi, pi], in cyclic order
+    std::vector<float> costs;   // while detecting: each group's cheapest candidate
   };
 
   /// The angle of point p around edge `seam`, seen from its vertex v; or
@@ -918,7 +919,8 @@ private:
     return std::atan2(across.dot(seam.across2), across.dot(seam.across1));
   }
 
-  /// The sheet of `seam` within half the smallest gap of `angle`, or -1.
+  /// The sheet of `seam` within half the smallest gap between sheets (and
+  /// max_sheet_bending) of `angle`, or -1 (also for NaN: along the axis).
   static int sheetAt(const SeamAxis &seam, double angle) {
     const std::size_t n = seam.sheets.size();
     double tolerance = M_PI;
