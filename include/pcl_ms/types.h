@@ -251,8 +251,9 @@ struct Result {
   /// Distinct initial triangles that are in the output mesh (either mode).
   std::size_t initial_kept = 0;
   /// With Parameters::allow_non_manifold: the edges that hold three or more
-  /// triangles (user indices, smaller first, sorted), and the triangles the
-  /// seam pass added (they are in `triangles` too).
+  /// triangles (user indices, smaller first, sorted), and how many triangles
+  /// joined the finished surface along the seams: those on seam edges and
+  /// the seam pass's fillers (they are in `triangles` too).
   std::vector<std::array<VertexIndex, 2>> seam_edges;
   std::size_t seam_triangles = 0;
   BucketStatistics bucket_statistics;

@@ -56,8 +56,9 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
                               const Eigen::Vector3d *viewpoint = nullptr);
 
 /// The seam pass's triangles (docs/algorithm.md, "Seams (opt-in)") join a
-/// surface finished from the greedy's `greedy` triangles: exact repeats and
-/// those on an edge where the finish added a triangle are left out, each new
+/// surface finished from the greedy's `greedy` triangles: triangles the
+/// finish added (hole fills) on their edges are removed, exact repeats left
+/// out, each new
 /// triangle takes the orientation of its sheet across edges with two
 /// triangles (the finished ones keep theirs), components become the
 /// manifold sheets (joined across edges with exactly two triangles) and

@@ -48,8 +48,9 @@ public:
   /// without the scaffold's fixed triangles when `with_fixed` is false.
   std::vector<Triangle> triangles(bool with_fixed = true) const;
   /// With Parameters::allow_non_manifold, the triangles of the seam pass
-  /// (docs/algorithm.md, "Seams (opt-in)"), kept apart from triangles(): the
-  /// 2-manifold mesh is finished first and these join it afterwards.
+  /// and the mesh's triangles on seam edges (docs/algorithm.md, "Seams
+  /// (opt-in)"), kept apart from triangles(): the 2-manifold rest is
+  /// finished first and these join it afterwards.
   std::vector<Triangle> seamTriangles() const;
   const GreedyStatistics &statistics() const { return statistics_; }
 
