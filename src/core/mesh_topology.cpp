@@ -5,6 +5,7 @@
 #include <pcl_ms/mesh_topology.h>
 
 #include <algorithm>
+#include <cassert>
 #include <stdexcept>
 #include <string>
 
@@ -28,9 +29,11 @@ std::array<EdgeIndex, 2> MeshTopology::edgesAt(CandidateIndex t, VertexIndex v) 
 }
 
 void MeshTopology::add(CandidateIndex t) {
+  assert(t < in_mesh_.size() && !in_mesh_[t]);
   const Candidate &candidate = scaffold_.candidates[t];
   for (int k = 0; k < 3; ++k) {
     auto &slots = edge_slots_[candidate.edges[k]];
+    assert(slots[1] == no_candidate && "the 2-manifold edge rule: a third triangle on an edge");
     const int before = (slots[0] != no_candidate) + (slots[1] != no_candidate);
     (slots[0] == no_candidate ? slots[0] : slots[1]) = t;
     // An edge with one triangle is a boundary edge of both its vertices.
@@ -47,9 +50,11 @@ void MeshTopology::add(CandidateIndex t) {
 }
 
 void MeshTopology::remove(CandidateIndex t) {
+  assert(t < in_mesh_.size() && in_mesh_[t]);
   const Candidate &candidate = scaffold_.candidates[t];
   for (int k = 0; k < 3; ++k) {
     auto &slots = edge_slots_[candidate.edges[k]];
+    assert((slots[0] == t || slots[1] == t) && "a mesh triangle missing from its edge");
     (slots[0] == t ? slots[0] : slots[1]) = no_candidate;
     const int after = (slots[0] != no_candidate) + (slots[1] != no_candidate);
     const int delta = after == 0 ? -1 : 1;
