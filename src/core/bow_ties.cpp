@@ -1,8 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Stage 4, bow-ties (docs/algorithm.md section 4, "Twists"). In: a triangle
-// list and the vertices to look at. Out: the list with one fan (the largest)
-// left at each such vertex; the corners of removed triangles are looked at
-// again.
+// list and the vertices to check. Out: the list with one fan (the largest)
+// left at each of them; corners of removed triangles are checked in turn.
 #include "finish_steps.h"
 
 #include <pcl_ms/mesh_topology.h>

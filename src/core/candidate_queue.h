@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The greedy's priority queue (docs/algorithm.md section 3). In: (cost,
 // candidate) entries, pushed again when a cost changes. Out: the entries
-// cheapest first, ties by candidate index; outdated ones are the caller's to
-// skip. Internal to the library: not installed.
+// cheapest first, ties by candidate index; the caller skips outdated ones.
+// Internal to the library: not installed.
 #pragma once
 
 #include <pcl_ms/scaffold.h> // CandidateIndex

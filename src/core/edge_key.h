@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// One key per undirected edge, for sorting, searching and hashing edges. In:
-// the edge's two vertex indices, in either order. Out: a 64-bit key with the
-// smaller index in the high word, so keys sort like (smaller, larger) pairs.
-// Internal to the library (not installed); the in-tree tools use it too.
+// One key per undirected edge (docs/algorithm.md, "Code layout"). In: its two
+// vertex indices, in either order. Out: a 64-bit key, smaller index in the
+// high word, so keys sort like (smaller, larger) pairs. Internal to the
+// library (not installed); the in-tree tools use it too.
 #pragma once
 
 #include <pcl_ms/types.h>

@@ -1,10 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Stage 4, finishing (docs/algorithm.md section 4). In: the greedy's
-// triangles and the points. Out: a FinishedSurface: bow-ties split, small
-// holes filled, folds cut, components oriented, boundary loops traced. This
-// file drives the steps and builds the mesh structure they share (edge uses,
-// boundary loops, manifold pairs); the steps are in hole_filling.cpp,
-// orientation.cpp and bow_ties.cpp.
+// triangles and the points. Out: a FinishedSurface: small holes filled, folds
+// cut, bow-ties split, components oriented, boundary loops traced. The steps
+// are in hole_filling.cpp, orientation.cpp, bow_ties.cpp; this file drives them.
 #include "finish_steps.h"
 
 #include <algorithm>
@@ -105,6 +103,7 @@ std::vector<ManifoldPair> manifoldPairs(const EdgeUses &uses) {
 
 namespace {
 
+// Twists are cut and the opened loops refilled at most this many times.
 constexpr int max_untwist_rounds = 3;
 // Loops opened by cutting twists are closed again up to this size.
 constexpr int max_untwist_loop_edges = 16;

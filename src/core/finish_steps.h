@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The finishing steps (docs/algorithm.md section 4) and the mesh structure
-// they share. In: a triangle list. Out: its edge uses, boundary loops and
-// manifold pairs (finish.cpp), filled holes (hole_filling.cpp), orientation
-// and the triangles to cut at twists (orientation.cpp), split bow-ties
-// (bow_ties.cpp). Internal to the library: not installed.
+// Stage 4's steps and the mesh structure they share (docs/algorithm.md
+// section 4). In: a triangle list. Out: edge uses, boundary loops, manifold
+// pairs (finish.cpp), filled holes (hole_filling.cpp), orientation and cuts
+// (orientation.cpp), dropped triangles (bow_ties.cpp). Internal: not installed.
 #pragma once
 
 #include "edge_key.h"

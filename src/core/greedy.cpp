@@ -1,12 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Stage 3, greedy gap transforms (docs/algorithm.md section 3). In: the
 // scaffold's candidates and the points. Out: an edge-manifold triangle list,
-// accepted cheapest first, with the passes' statistics. This file holds the
-// passes (queues, costs, decisions, undo); the clean-up after them is in
-// greedy_repair.cpp, the opt-in seams in greedy_seams.cpp.
+// accepted cheapest first, with the passes' statistics. Here the passes; the
+// repairs after them in greedy_repair.cpp, opt-in seams in greedy_seams.cpp.
 #include "greedy_impl.h"
-
-#include "edge_key.h"
 
 #include <pcl_ms/costs.h>
 
@@ -491,6 +488,24 @@ void GreedyMesher::Impl::undo(CandidateIndex t) {
   }
   push(t, State::queue2);
 }
+/// Between the passes: triangles with at most one shared edge (flaps,
+/// isolated triangles) go back to Q2.
+void GreedyMesher::Impl::removeFlapsAndIsolatedTriangles() {
+  std::vector<CandidateIndex> loose;
+  for (CandidateIndex t = 0; t < candidates_.size(); ++t) {
+    if (!mesh_.contains(t) || is_fixed_[t])
+      continue;
+    int shared_edges = 0;
+    for (EdgeIndex e : candidates_[t].edges)
+      shared_edges += mesh_.edgeTriangleCount(e) == 2;
+    if (shared_edges <= 1)
+      loose.push_back(t);
+  }
+  for (CandidateIndex t : loose)
+    undo(t);
+  statistics_.cleanup_undone += loose.size();
+}
+
 GreedyMesher::GreedyMesher(MedialScaffold &scaffold, const std::vector<Eigen::Vector3d> &points,
                            const Parameters &parameters, const Deadline *deadline)
     : impl_(std::make_unique<Impl>(scaffold, points, parameters, deadline, statistics_)) {}

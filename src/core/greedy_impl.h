@@ -1,17 +1,18 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Stage 3's working state (docs/algorithm.md sections 3 and 4a). In: the
-// scaffold's candidates, the points and the parameters. Out: the class behind
-// GreedyMesher, defined in greedy.cpp (the passes), greedy_repair.cpp (clean-up,
-// diagonal swaps, manifold sweep) and greedy_seams.cpp (seam detection, seam pass).
-// Internal to the library: not installed.
+// Stage 3's state (docs/algorithm.md sections 3, 4a). In: the scaffold's
+// candidates, the points, the parameters. Out: GreedyMesher::Impl, defined in
+// greedy.cpp (passes), greedy_repair.cpp (diagonal swaps, manifold sweep) and
+// greedy_seams.cpp (seam detection, seam pass). Internal: not installed.
 #pragma once
 
 #include "candidate_queue.h"
+#include "edge_key.h"
 
 #include <pcl_ms/greedy.h>
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
@@ -19,7 +20,9 @@
 namespace pcl_ms {
 namespace detail {
 
-enum class State : std::uint8_t { idle, queue1, queue2, accepted, dropped };
+/// Where a candidate is: not queued, waiting in Q1 or Q2, in the mesh, or
+/// out for good.
+enum class GreedyState : std::uint8_t { idle, queue1, queue2, accepted, dropped };
 
 /// A likely seam edge: its axis (unit, from its lower to its higher end),
 /// a frame across it, and the directions of its sheets in that frame.
@@ -42,7 +45,7 @@ public:
   std::vector<Triangle> triangles(bool with_fixed) const;
 
 private:
-  using State = detail::State;
+  using State = detail::GreedyState;
   using SeamAxis = detail::SeamAxis;
   using QueueEntry = detail::QueueEntry;
   using CandidateQueue = detail::CandidateQueue;
@@ -155,10 +158,10 @@ private:
   void removeFromMesh(CandidateIndex t);
   bool isClosedFan(const std::vector<CandidateIndex> &fan, VertexIndex v) const;
   void undo(CandidateIndex t);
-
-  // ---- clean-up, diagonal swaps, manifold sweep (greedy_repair.cpp) --------
-
   void removeFlapsAndIsolatedTriangles();
+
+  // ---- after pass 2: diagonal swaps, manifold sweep (greedy_repair.cpp) ----
+
   EdgeIndex edgeBetween(CandidateIndex t, VertexIndex a, VertexIndex b) const;
   CandidateIndex candidateWith(EdgeIndex e, VertexIndex a, VertexIndex b, VertexIndex apex) const;
   void listUnnumberedCandidates();
@@ -232,7 +235,7 @@ private:
   std::vector<double> delay_multiplier_;
   // Edges numbered here (type III candidates): their ids by end points, and
   // who is on them.
-  std::unordered_map<std::uint64_t, EdgeIndex> new_edges_;
+  std::unordered_map<detail::EdgeKey, EdgeIndex> new_edges_;
   std::vector<std::uint32_t> late_offsets_;
   std::vector<CandidateIndex> late_candidates_;
   std::unordered_map<EdgeIndex, std::vector<CandidateIndex>> swapped_in_;

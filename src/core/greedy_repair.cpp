@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Stage 3's clean-up (docs/algorithm.md section 3). In: the triangles the
-// greedy passes accepted. Out: the same mesh without flaps and isolated
-// triangles (between the passes), with non-Delaunay quads swapped for the
-// other diagonal and one fan per vertex (after pass 2).
+// Stage 3's repairs after pass 2 (docs/algorithm.md section 3). In: the mesh
+// the passes accepted. Out: the same with non-Delaunay quads swapped for the
+// other diagonal where that bends the surface no more, and one fan per vertex
+// (the manifold sweep).
 #include "greedy_impl.h"
 
 #include <pcl_ms/costs.h>
@@ -23,22 +23,6 @@ constexpr double swap_angle_tolerance = 1e-9;
 constexpr double smooth_bending_angle = 0.35;
 
 } // namespace
-
-void GreedyMesher::Impl::removeFlapsAndIsolatedTriangles() {
-  std::vector<CandidateIndex> loose;
-  for (CandidateIndex t = 0; t < candidates_.size(); ++t) {
-    if (!mesh_.contains(t) || is_fixed_[t])
-      continue;
-    int shared_edges = 0;
-    for (EdgeIndex e : candidates_[t].edges)
-      shared_edges += mesh_.edgeTriangleCount(e) == 2;
-    if (shared_edges <= 1)
-      loose.push_back(t);
-  }
-  for (CandidateIndex t : loose)
-    undo(t);
-  statistics_.cleanup_undone += loose.size();
-}
 
 /// The edge of candidate t joining a and b (both vertices of t).
 EdgeIndex GreedyMesher::Impl::edgeBetween(CandidateIndex t, VertexIndex a, VertexIndex b) const {

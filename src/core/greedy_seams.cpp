@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Stage 3's opt-in seams (docs/algorithm.md section 4a). In: the scaffold's
-// candidates before the passes, the 2-manifold mesh after them. Out: the
-// likely seam edges and the candidates bridging them (left out of the
-// passes), then the seam pass's triangles and the mesh's triangles set apart
-// on seam edges.
+// candidates before the passes, the 2-manifold mesh after them. Out: likely
+// seam edges and the candidates bridging them (left out of the passes), then
+// the seam pass's triangles and the mesh's triangles set apart at seams.
 #include "greedy_impl.h"
 
 #include <pcl_ms/costs.h>
