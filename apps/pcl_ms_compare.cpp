@@ -16,6 +16,7 @@
 #include <pcl_ms/mesh_quality.h>
 
 #include <pcl/PolygonMesh.h>
+#include <pcl/console/parse.h>
 #include <pcl/conversions.h>
 
 #include <algorithm>
@@ -111,40 +112,25 @@ bool parsePictureSize(const std::string &text, int &size, std::string &error) {
 
 bool parseArguments(int argc, char **argv, Options &options, std::string &error) {
   std::vector<std::string> positional;
-  for (int i = 1; i < argc; ++i) {
-    const std::string argument = argv[i];
-    if (argument == "-h" || argument == "--help") {
-      options.help = true;
-    } else if (argument == "-q") {
-      options.quiet = true;
-    } else if (argument == "-medial_axis") {
-      options.medial_axis = true;
-    } else if (argument == "-non_manifold") {
-      options.non_manifold = true;
-    } else if (argument == "-gt" || argument == "-out" || argument == "-methods" ||
-               argument == "-picture_size") {
-      if (i + 1 >= argc) {
-        error = argument + " needs a value";
-        return false;
-      }
-      const std::string value = argv[++i];
-      if (argument == "-gt") {
-        options.reference = value;
-      } else if (argument == "-out") {
-        options.out_dir = value;
-      } else if (argument == "-picture_size") {
-        if (!parsePictureSize(value, options.picture_size, error))
-          return false;
-      } else if (!parseMethods(value, options.methods, error)) {
-        return false;
-      }
-    } else if (argument.size() > 1 && argument[0] == '-') {
-      error = "unknown option '" + argument + "' (see -h)";
-      return false;
-    } else {
-      positional.push_back(argument);
-    }
-  }
+  if (!pcl_ms_tools::checkArguments(
+          argc, argv, {"-h", "--help", "-q", "-medial_axis", "-non_manifold"},
+          {"-gt", "-out", "-methods", "-picture_size"}, positional, error))
+    return false;
+  using pcl::console::find_switch;
+  using pcl::console::parse_argument;
+  options.help = find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help");
+  options.quiet = find_switch(argc, argv, "-q");
+  options.medial_axis = find_switch(argc, argv, "-medial_axis");
+  options.non_manifold = find_switch(argc, argv, "-non_manifold");
+  parse_argument(argc, argv, "-gt", options.reference);
+  parse_argument(argc, argv, "-out", options.out_dir);
+  std::string value;
+  if (parse_argument(argc, argv, "-picture_size", value) >= 0 &&
+      !parsePictureSize(value, options.picture_size, error))
+    return false;
+  if (parse_argument(argc, argv, "-methods", value) >= 0 &&
+      !parseMethods(value, options.methods, error))
+    return false;
   if (options.help)
     return true;
   if (positional.size() != 1) {

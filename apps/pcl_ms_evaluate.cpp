@@ -10,6 +10,8 @@
 #include <pcl_ms/io.h>
 #include <pcl_ms/mesh_quality.h>
 
+#include <pcl/console/parse.h>
+
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -43,25 +45,14 @@ void printHelp(const char *program) {
 
 bool parseArguments(int argc, char **argv, Options &options, std::string &error) {
   std::vector<std::string> positional;
-  for (int i = 1; i < argc; ++i) {
-    const std::string argument = argv[i];
-    if (argument == "-h" || argument == "--help") {
-      options.help = true;
-    } else if (argument == "-json") {
-      options.json = true;
-    } else if (argument == "-gt" || argument == "-points") {
-      if (i + 1 >= argc) {
-        error = argument + " needs a value";
-        return false;
-      }
-      (argument == "-gt" ? options.reference : options.points) = argv[++i];
-    } else if (argument.size() > 1 && argument[0] == '-') {
-      error = "unknown option '" + argument + "' (see -h)";
-      return false;
-    } else {
-      positional.push_back(argument);
-    }
-  }
+  if (!pcl_ms_tools::checkArguments(argc, argv, {"-h", "--help", "-json"}, {"-gt", "-points"},
+                                    positional, error))
+    return false;
+  using pcl::console::find_switch;
+  options.help = find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help");
+  options.json = find_switch(argc, argv, "-json");
+  pcl::console::parse_argument(argc, argv, "-gt", options.reference);
+  pcl::console::parse_argument(argc, argv, "-points", options.points);
   if (options.help)
     return true;
   if (positional.size() != 1) {

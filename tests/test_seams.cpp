@@ -171,6 +171,20 @@ TEST(Seams, TwoBoxesSharingAFace) {
   expectSeams(cloud, run(cloud, true), 3, "two boxes");
 }
 
+// A bucket size that would cut the cloud into pieces does not drop the seams:
+// with the option on the cloud is meshed in one piece.
+TEST(Seams, ABucketSizeDoesNotDropTheSeams) {
+  const SeamCloud cloud = threeHalfPlanes();
+  pcl_ms::Parameters parameters;
+  parameters.allow_non_manifold = true;
+  parameters.bucket_points = 1000;
+  const pcl_ms::Result result = pcl_ms::reconstruct(viewOf(cloud.xyz), parameters);
+  EXPECT_EQ(result.bucket_statistics.buckets, 0u);
+  EXPECT_EQ(result.triangles, run(cloud, true).triangles);
+  parameters.allow_non_manifold = false;
+  EXPECT_GT(pcl_ms::reconstruct(viewOf(cloud.xyz), parameters).bucket_statistics.buckets, 1u);
+}
+
 /// On manifold surfaces the option finds no seam: no seam edge, no edge
 /// with more than two triangles, and the output of the option off.
 void expectNoFalseSeams(const std::vector<float> &xyz, const char *name) {

@@ -65,11 +65,12 @@ public:
   void setUseNormals(bool use) { parameters_.use_normals = use; }
   bool getUseNormals() const { return parameters_.use_normals; }
 
-  /** \brief Non-manifold seams (default off): after pass 2, a third pass may
-   * put a third (fourth...) triangle on an edge where sheets meet, when it
-   * bends to the triangles there by 0.2-2.9 rad; orientation is then per
-   * manifold sheet and the result's seam_edges lists those edges. Off, the
-   * output is 2-manifold. Honoured when the cloud is meshed in one piece. */
+  /** \brief Non-manifold seams (default off): lines where three or more
+   * sheets of candidates meet are found before the greedy passes and kept as
+   * edges, and a seam pass after pass 2 puts one triangle per sheet on them
+   * (docs/algorithm.md, "Seams"). Orientation is then per manifold sheet and
+   * the result's seam_edges lists those edges. Off, the output is
+   * 2-manifold. On, the cloud is meshed in one piece whatever its size. */
   void setAllowNonManifold(bool allow) { parameters_.allow_non_manifold = allow; }
   bool getAllowNonManifold() const { return parameters_.allow_non_manifold; }
 

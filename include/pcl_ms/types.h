@@ -157,8 +157,9 @@ struct Parameters {
   bool compute_medial_axis = false;
   /// Non-manifold seams (docs/algorithm.md, "Seams (opt-in)"): after pass 2 a
   /// third pass may put a third (fourth...) triangle on an edge where sheets
-  /// meet. Off by default: the output is then 2-manifold. One-piece runs only
-  /// (a bucketed run ignores it).
+  /// meet. Off by default: the output is then 2-manifold. A cloud is meshed in
+  /// one piece when it is on, whatever its size: the bucket units do not
+  /// look for seams.
   bool allow_non_manifold = false;
 
   /// Empty when valid, else a one-line reason.

@@ -375,9 +375,9 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
   std::vector<Triangle> seam_triangles;   // Parameters::allow_non_manifold
   std::vector<Triangle> greedy_triangles; // what the finish starts from, with seams
   std::vector<float> local_scale;         // per distinct point
-  // Initial triangles are honoured by the one-piece path only.
-  const bool in_buckets =
-      initial_triangles.empty() && usesBuckets(prepared.positions.size(), parameters);
+  // Initial triangles and seams are honoured by the one-piece path only.
+  const bool in_buckets = initial_triangles.empty() && !parameters.allow_non_manifold &&
+                          usesBuckets(prepared.positions.size(), parameters);
   // Only process 0 meshes a one-piece cloud and finishes the surface.
   const bool gathers = exchange.process() == 0;
   if (!in_buckets && !gathers)

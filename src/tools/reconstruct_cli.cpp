@@ -126,34 +126,18 @@ bool parseReconstructArguments(int argc, char **argv, ReconstructOptions &option
       "-grid",    "-viewpoint",    "-time_limit",  "-estimate_normals",
       "-initial", "-initial_mode", "-medial_axis", "-normal_weight"};
   std::vector<std::string> positional;
-  for (int i = 1; i < argc; ++i) {
-    const std::string argument = argv[i];
-    if (argument == "-h" || argument == "--help") {
-      options.help = true;
-    } else if (argument == "-normals") {
-      options.normals = true;
-    } else if (argument == "-non_manifold") {
-      options.non_manifold = true;
-    } else if (argument == "-q") {
-      options.quiet = true;
-    } else if (argument == "-no_viewpoint") {
-      options.no_viewpoint = true;
-    } else if (argument == "-keep_layout") {
-      options.keep_layout = true;
-    } else if (std::find(value_options.begin(), value_options.end(), argument) !=
-               value_options.end()) {
-      if (i + 1 >= argc) {
-        error = argument + " needs a value";
-        return false;
-      }
-      ++i; // the value itself is parsed below
-    } else if (argument.size() > 1 && argument[0] == '-') {
-      error = "unknown option '" + argument + "' (see -h)";
-      return false;
-    } else {
-      positional.push_back(argument);
-    }
-  }
+  if (!checkArguments(
+          argc, argv,
+          {"-h", "--help", "-normals", "-non_manifold", "-q", "-no_viewpoint", "-keep_layout"},
+          value_options, positional, error))
+    return false;
+  using pcl::console::find_switch;
+  options.help = find_switch(argc, argv, "-h") || find_switch(argc, argv, "--help");
+  options.normals = find_switch(argc, argv, "-normals");
+  options.non_manifold = find_switch(argc, argv, "-non_manifold");
+  options.quiet = find_switch(argc, argv, "-q");
+  options.no_viewpoint = find_switch(argc, argv, "-no_viewpoint");
+  options.keep_layout = find_switch(argc, argv, "-keep_layout");
   if (options.help)
     return true;
 

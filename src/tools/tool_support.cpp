@@ -3,6 +3,7 @@
 
 #include <pcl/conversions.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -62,6 +63,33 @@ std::optional<std::array<double, 3>> sensorViewpoint(const pcl::PCLPointCloud2 &
   if (cloud.height <= 1 && sensor_origin.head<3>() == Eigen::Vector3f::Zero())
     return std::nullopt;
   return std::array<double, 3>{sensor_origin[0], sensor_origin[1], sensor_origin[2]};
+}
+
+bool checkArguments(int argc, char **argv, const std::vector<std::string> &switches,
+                    const std::vector<std::string> &value_options,
+                    std::vector<std::string> &positional, std::string &error) {
+  const auto known = [](const std::vector<std::string> &names, const std::string &name) {
+    return std::find(names.begin(), names.end(), name) != names.end();
+  };
+  positional.clear();
+  for (int i = 1; i < argc; ++i) {
+    const std::string argument = argv[i];
+    if (known(switches, argument))
+      continue;
+    if (known(value_options, argument)) {
+      if (i + 1 >= argc) {
+        error = argument + " needs a value";
+        return false;
+      }
+      ++i; // the value, read by the caller
+    } else if (argument.size() > 1 && argument[0] == '-') {
+      error = "unknown option '" + argument + "' (see -h)";
+      return false;
+    } else {
+      positional.push_back(argument);
+    }
+  }
+  return true;
 }
 
 } // namespace pcl_ms_tools

@@ -44,6 +44,15 @@ private:
   pcl::console::VERBOSITY_LEVEL previous_;
 };
 
+/// Checks a command line against the options a program knows, before their
+/// values are read with pcl::console's parse_argument family (which skips
+/// what it does not know and cannot tell a missing value): every argument
+/// starting with '-' must be one of `switches` or of `value_options`, the
+/// latter followed by a value; the others are returned in `positional`.
+bool checkArguments(int argc, char **argv, const std::vector<std::string> &switches,
+                    const std::vector<std::string> &value_options,
+                    std::vector<std::string> &positional, std::string &error);
+
 /// The cloud's points with finite x, y, z, in order; returns how many were
 /// skipped. The cloud must have float x, y, z (pcl_ms::loadPointCloud ensures it).
 std::size_t finitePoints(const pcl::PCLPointCloud2 &cloud, pcl::PointCloud<pcl::PointXYZ> &points);
