@@ -3,6 +3,8 @@
 // (mesh_quality_topology.cpp, mesh_quality_reference.cpp). Internal.
 #pragma once
 
+#include "edge_key.h"
+
 #include <pcl_ms/types.h>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -43,11 +45,8 @@ inline bool isDegenerate(const std::vector<Eigen::Vector3d> &vertices, const Tri
                          PredicateKernel::Point_3(c.x(), c.y(), c.z()));
 }
 
-inline std::uint64_t edgeKey(VertexIndex a, VertexIndex b) {
-  const VertexIndex low = std::min(a, b);
-  const VertexIndex high = std::max(a, b);
-  return (static_cast<std::uint64_t>(low) << 32) | high;
-}
+// The core's key for an undirected edge (src/core/edge_key.h).
+using detail::edgeKey;
 
 inline Triangle sortedCorners(Triangle triangle) {
   std::sort(triangle.begin(), triangle.end());

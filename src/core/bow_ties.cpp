@@ -1,0 +1,118 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Stage 4, bow-ties (docs/algorithm.md section 4, "Twists"). In: a triangle
+// list and the vertices to check. Out: the list with one fan (the largest)
+// left at each of them; corners of removed triangles are checked in turn.
+#include "finish_steps.h"
+
+#include <pcl_ms/mesh_topology.h>
+
+#include <algorithm>
+#include <array>
+
+namespace pcl_ms {
+namespace detail {
+namespace {
+
+/// The triangles at each marked vertex: one scan of the mesh, and memory
+/// for the marked vertices only (a few, or a seam's, of a large mesh).
+class MarkedIncidence {
+public:
+  MarkedIncidence(const std::vector<Triangle> &triangles, const std::vector<bool> &marked) {
+    for (VertexIndex v = 0; v < marked.size(); ++v)
+      if (marked[v])
+        vertices_.push_back(v);
+    at_.resize(vertices_.size());
+    for (std::uint32_t t = 0; t < triangles.size(); ++t)
+      for (VertexIndex v : triangles[t])
+        if (v < marked.size() && marked[v])
+          at_[slot(v)].push_back(t);
+  }
+  const std::vector<VertexIndex> &vertices() const { return vertices_; }
+  const std::vector<std::uint32_t> &atSlot(std::size_t slot) const { return at_[slot]; }
+  const std::vector<std::uint32_t> &at(VertexIndex v) const { return at_[slot(v)]; }
+
+private:
+  std::size_t slot(VertexIndex v) const {
+    return static_cast<std::size_t>(std::lower_bound(vertices_.begin(), vertices_.end(), v) -
+                                    vertices_.begin());
+  }
+  std::vector<VertexIndex> vertices_; // ascending
+  std::vector<std::vector<std::uint32_t>> at_;
+};
+
+/// The triangles at v (given in `around`) grouped into fans joined by edges at v.
+std::vector<std::vector<std::uint32_t>> fansAt(VertexIndex v,
+                                               const std::vector<std::uint32_t> &around,
+                                               const std::vector<Triangle> &triangles) {
+  auto otherCorners = [&](std::uint32_t t) {
+    std::array<VertexIndex, 2> corners{};
+    int n = 0;
+    for (VertexIndex w : triangles[t])
+      if (w != v && n < 2)
+        corners[n++] = w;
+    return corners;
+  };
+  // Two triangles at v are in one fan when they share a second corner.
+  const auto groups = connectedGroups(around.size(), [&](const auto &join) {
+    for (std::size_t i = 0; i < around.size(); ++i)
+      for (std::size_t j = i + 1; j < around.size(); ++j) {
+        const auto a = otherCorners(around[i]), b = otherCorners(around[j]);
+        if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1])
+          join(i, j);
+      }
+  });
+  std::vector<std::vector<std::uint32_t>> fans(groups.size());
+  for (std::size_t f = 0; f < groups.size(); ++f)
+    for (std::size_t i : groups[f])
+      fans[f].push_back(around[i]);
+  return fans;
+}
+
+} // namespace
+
+void dropTriangles(std::vector<Triangle> &triangles, const std::vector<bool> &drop,
+                   std::vector<bool> &touched) {
+  std::size_t write = 0;
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    if (drop[t])
+      for (VertexIndex v : triangles[t])
+        touched[v] = true;
+    else
+      triangles[write++] = triangles[t];
+  }
+  triangles.resize(write);
+}
+
+} // namespace detail
+
+std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_count,
+                         std::vector<bool> &touched) {
+  const std::size_t before = triangles.size();
+  touched.resize(vertex_count, false);
+  for (bool changed = true; changed;) {
+    changed = false;
+    const detail::MarkedIncidence incidence(triangles, touched);
+    std::vector<bool> drop(triangles.size(), false);
+    for (std::size_t slot = 0; slot < incidence.vertices().size(); ++slot) {
+      const VertexIndex v = incidence.vertices()[slot];
+      if (incidence.atSlot(slot).size() < 2)
+        continue;
+      const auto fans = detail::fansAt(v, incidence.atSlot(slot), triangles);
+      if (fans.size() < 2)
+        continue;
+      std::size_t keep = 0;
+      for (std::size_t f = 1; f < fans.size(); ++f)
+        if (fans[f].size() > fans[keep].size())
+          keep = f;
+      for (std::size_t f = 0; f < fans.size(); ++f)
+        if (f != keep)
+          for (std::uint32_t t : fans[f])
+            drop[t] = changed = true;
+    }
+    if (changed)
+      detail::dropTriangles(triangles, drop, touched);
+  }
+  return before - triangles.size();
+}
+
+} // namespace pcl_ms

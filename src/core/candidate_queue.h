@@ -1,0 +1,140 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The greedy's priority queue (docs/algorithm.md section 3). In: (cost,
+// candidate) entries, pushed again when a cost changes. Out: the entries
+// cheapest first, ties by candidate index; the caller skips outdated ones.
+// Internal to the library: not installed.
+#pragma once
+
+#include <pcl_ms/scaffold.h> // CandidateIndex
+
+#include <boost/heap/d_ary_heap.hpp>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <iterator>
+#include <vector>
+
+namespace pcl_ms {
+namespace detail {
+
+/// A queued cost and its candidate packed into one integer that orders them
+/// cheapest first, ties by candidate index: the cost's bits form the high
+/// word, and costs are never negative (freshCost clamps at +0, NaN included),
+/// so their IEEE bit patterns sort like the values. One integer comparison
+/// per heap step instead of two float tests and a tie-break.
+class QueueEntry {
+public:
+  QueueEntry(float cost, CandidateIndex candidate)
+      : key_(std::uint64_t{bitsOf(cost)} << 32 | candidate) {}
+  float cost() const {
+    const auto bits = static_cast<std::uint32_t>(key_ >> 32);
+    float cost;
+    std::memcpy(&cost, &bits, sizeof cost);
+    return cost;
+  }
+  CandidateIndex candidate() const { return static_cast<CandidateIndex>(key_); }
+  // Boost's heaps keep the greatest element on top: "greater" puts the
+  // cheapest first.
+  bool operator>(const QueueEntry &other) const { return key_ > other.key_; }
+  bool operator<(const QueueEntry &other) const { return key_ < other.key_; }
+
+private:
+  static std::uint32_t bitsOf(float cost) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &cost, sizeof bits);
+    return bits;
+  }
+
+  std::uint64_t key_;
+};
+
+struct CheaperFirst {
+  bool operator()(const QueueEntry &a, const QueueEntry &b) const { return a > b; }
+};
+
+/// The queue of one pass. Most entries arrive together before the pass
+/// pops any (the pass's initial costs): those are sorted once and read in
+/// order, which costs far less than sifting each through a heap of millions
+/// of entries, the greedy's main cost at 300,000 points. Entries pushed while
+/// the pass runs (changed costs) go to a small heap. Boost's contiguous d-ary
+/// heap has no handles: a candidate whose cost changes is pushed again and
+/// its outdated entry skipped when it surfaces (lazy deletion). Entries are
+/// totally ordered, so the pops come in the same order as from one heap.
+class CandidateQueue {
+public:
+  void push(const QueueEntry &entry) { arrived_.push_back(entry); }
+  bool empty() const { return size() == 0; }
+  const QueueEntry &top() {
+    settleArrivals();
+    return sortedRunFirst() ? sorted_[next_] : heap_.top();
+  }
+  void pop() {
+    settleArrivals();
+    if (sortedRunFirst())
+      ++next_;
+    else
+      heap_.pop();
+  }
+  std::size_t size() const { return sorted_.size() - next_ + heap_.size() + arrived_.size(); }
+  /// The candidate `steps` places further along the sorted run, if any: the
+  /// pass fetches its data early, as the run visits candidates in no order
+  /// of memory.
+  const QueueEntry *sortedAhead(std::size_t steps) const {
+    return next_ + steps < sorted_.size() ? &sorted_[next_ + steps] : nullptr;
+  }
+
+  /// Drops the outdated entries.
+  template <typename IsCurrent> void compact(const IsCurrent &is_current) {
+    settleArrivals();
+    std::vector<QueueEntry> current;
+    std::copy_if(sorted_.begin() + static_cast<std::ptrdiff_t>(next_), sorted_.end(),
+                 std::back_inserter(current), is_current);
+    sorted_ = std::move(current);
+    next_ = 0;
+    std::vector<QueueEntry> in_heap;
+    for (auto it = heap_.begin(); it != heap_.end(); ++it)
+      if (is_current(*it))
+        in_heap.push_back(*it);
+    heap_.clear();
+    heap_.reserve(in_heap.size());
+    for (const QueueEntry &entry : in_heap)
+      heap_.push(entry);
+  }
+
+private:
+  // A batch at least this large is sorted and merged into the sorted run
+  // rather than pushed onto the heap one by one.
+  static constexpr std::size_t min_sorted_batch = 1024;
+
+  bool sortedRunFirst() const {
+    return next_ < sorted_.size() && (heap_.empty() || !(heap_.top() < sorted_[next_]));
+  }
+
+  void settleArrivals() {
+    if (arrived_.empty())
+      return;
+    if (arrived_.size() < min_sorted_batch) {
+      for (const QueueEntry &entry : arrived_)
+        heap_.push(entry);
+    } else {
+      std::sort(arrived_.begin(), arrived_.end());
+      std::vector<QueueEntry> merged;
+      merged.reserve(sorted_.size() - next_ + arrived_.size());
+      std::merge(sorted_.begin() + static_cast<std::ptrdiff_t>(next_), sorted_.end(),
+                 arrived_.begin(), arrived_.end(), std::back_inserter(merged));
+      sorted_ = std::move(merged);
+      next_ = 0;
+    }
+    arrived_.clear();
+  }
+
+  std::vector<QueueEntry> arrived_; // pushed, not yet placed
+  std::vector<QueueEntry> sorted_;  // ascending from next_
+  std::size_t next_ = 0;
+  boost::heap::d_ary_heap<QueueEntry, boost::heap::arity<4>, boost::heap::compare<CheaperFirst>>
+      heap_;
+};
+
+} // namespace detail
+} // namespace pcl_ms
