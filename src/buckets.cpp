@@ -587,6 +587,10 @@ private:
 
     // The subtree's triangles, then the seam's, in a fixed order.
     std::vector<Triangle> &merged = node.triangles;
+    // Sized once: at the root this is the whole surface, and growing it by
+    // doubling would hold up to three times its size while copying.
+    merged.reserve(nodes_()[node.children[0]].triangles.size() +
+                   nodes_()[node.children[1]].triangles.size() + added.size());
     for (int child : node.children) {
       std::vector<Triangle> &part = nodes_()[child].triangles;
       merged.insert(merged.end(), part.begin(), part.end());
