@@ -98,31 +98,16 @@ void printRankTable(const std::vector<RankFigures> &figures) {
   pcl_ms_tools::printRow("peak RSS, all ranks", "%10.1f", total_peak);
 }
 
-/// Fills `points` on every rank from rank 0's loaded cloud (files the ranks
-/// do not read in parts: ASCII, compressed, the other formats).
-template <typename PointT>
-void broadcastCloud(const Job &job, const pcl::PCLPointCloud2 &cloud,
-                    pcl::PointCloud<PointT> &points) {
-  if (job.rank == 0) {
-    SilencePclMessages silence;
-    pcl::fromPCLPointCloud2(cloud, points);
-  }
-  std::uint64_t count = points.size();
-  MPI_Bcast(&count, 1, MPI_UINT64_T, 0, job.communicator);
-  points.resize(count);
-  pcl_ms_mpi::broadcastBytes(points.data(), count * sizeof(PointT), 0, job.communicator);
-}
-
 /// What a rank found reading its byte range.
 struct SliceStatus {
   int code = kSuccess;
   int all_finite = 1; // every point has finite x, y, z
 };
 
-/// Every rank reads the records of its own byte range of a binary PCD, then
-/// each range goes to every rank (docs/algorithm.md, "Across processes").
-/// A range the file does not hold fails on its rank, with the reason there,
-/// and every rank returns kIoFailure.
+/// Every rank reads the records of its own byte range of a binary PCD and
+/// sends them to rank 0, which alone ends with all points (docs/algorithm.md,
+/// "Across processes"). A range the file does not hold fails on its rank,
+/// with the reason there, and every rank returns kIoFailure.
 template <typename PointT>
 SliceStatus readCloudInParts(const Job &job, const std::string &path,
                              const pcl_ms_mpi::BinaryCloudLayout &layout,
@@ -141,14 +126,16 @@ SliceStatus readCloudInParts(const Job &job, const std::string &path,
   MPI_Allreduce(&mine.code, &all.code, 1, MPI_INT, MPI_MAX, job.communicator);
   if (all.code != kSuccess)
     return all;
-  points.resize(layout.points);
+  // Rank 0 holds the whole cloud, the others their range only.
+  const std::uint64_t first_held = job.rank == 0 ? 0 : begin;
+  points.resize(job.rank == 0 ? layout.points : end - begin);
   auto field = [&](std::size_t record, std::uint32_t offset) {
     float value;
     std::memcpy(&value, bytes.data() + record * layout.record_bytes + offset, sizeof value);
     return value;
   };
   for (std::uint64_t i = begin; i < end; ++i) {
-    PointT &point = points[i];
+    PointT &point = points[i - first_held];
     point.x = field(i - begin, layout.xyz[0]);
     point.y = field(i - begin, layout.xyz[1]);
     point.z = field(i - begin, layout.xyz[2]);
@@ -161,23 +148,26 @@ SliceStatus readCloudInParts(const Job &job, const std::string &path,
       }
   }
   std::vector<unsigned char>().swap(bytes);
-  // Each rank's range to every rank, in rank order.
-  for (int r = 0; r < job.ranks; ++r) {
+  for (int r = 1; r < job.ranks; ++r) {
     const std::uint64_t first = pcl_ms_mpi::firstRecordOf(r, job.ranks, layout.points);
     const std::uint64_t last = pcl_ms_mpi::firstRecordOf(r + 1, job.ranks, layout.points);
-    pcl_ms_mpi::broadcastBytes(points.data() + first, (last - first) * sizeof(PointT), r,
+    if (job.rank == 0)
+      pcl_ms_mpi::receiveBytes(points.data() + first, (last - first) * sizeof(PointT), r,
                                job.communicator);
+    else if (job.rank == r)
+      pcl_ms_mpi::sendBytes(points.data(), points.size() * sizeof(PointT), 0, job.communicator);
   }
+  if (job.rank != 0)
+    pcl::PointCloud<PointT>().swap(points);
   MPI_Allreduce(&mine.all_finite, &all.all_finite, 1, MPI_INT, MPI_MIN, job.communicator);
   return all;
 }
 
-/// Meshes `points` (the same on every rank) and frees them; rank 0 gets
-/// the triangles.
+/// Rank 0: meshes `points`, with the other ranks meshing the units it
+/// hands out, and frees them.
 template <typename PointT>
 pcl_ms::Result meshPoints(const Job &job, pcl::PointCloud<PointT> &&points,
-                          const pcl_ms::Parameters &parameters,
-                          pcl_ms_mpi::MpiBucketExchange &exchange) {
+                          const pcl_ms::Parameters &parameters, pcl_ms_mpi::MpiUnitFarm &exchange) {
   const pcl::PointCloud<PointT> owned = std::move(points);
   // As pcl::MedialScaffoldReconstruction passes them: no indices, normals
   // from the point type.
@@ -241,10 +231,29 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
       print_info("Available dimensions: ");
       print_value("%s\n", fields.c_str());
     }
-  } else {
-    broadcastCloud(job, cloud, points);
+  } else if (on_rank_zero) {
+    SilencePclMessages silence;
+    pcl::fromPCLPointCloud2(cloud, points);
   }
   const double read_mb = peakResidentMegabytes();
+
+  if (!on_rank_zero) {
+    // The other ranks mesh the units rank 0 sends them, one at a time.
+    pcl_ms_mpi::ServedUnits served;
+    try {
+      served = pcl_ms_mpi::serveUnits(job.communicator, parameters);
+    } catch (const std::exception &error) {
+      abortJob(job, kReconstructionFailure, std::string("reconstruction failed: ") + error.what());
+    }
+    RankFigures mine{peakResidentMegabytes(),
+                     read_mb,
+                     0,
+                     served.seconds,
+                     static_cast<double>(served.bytes_sent) / (1 << 20),
+                     static_cast<double>(served.bytes_received) / (1 << 20)};
+    MPI_Gather(&mine, sizeof(RankFigures), MPI_BYTE, nullptr, 0, MPI_BYTE, 0, job.communicator);
+    return statusOfRankZero(job, kSuccess);
+  }
 
   if (verbose) {
     pcl_ms_tools::printReconstructStart(options, parameters);
@@ -258,12 +267,13 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
   const auto secondsSinceStart = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  pcl_ms_mpi::MpiBucketExchange exchange(job.communicator, [&](const std::string &stage) {
+  pcl_ms_mpi::MpiUnitFarm exchange(job.communicator, [&](const std::string &stage) {
     if (verbose)
       std::fprintf(stderr, "  all ranks: %s done, %.1f s elapsed\n", stage.c_str(),
                    secondsSinceStart());
   });
   pcl_ms::Result result = meshPoints(job, std::move(points), parameters, exchange);
+  exchange.release(); // the other ranks are done
   const double reconstruct_seconds = secondsSinceStart();
   if (verbose) {
     print_info("[done, ");
