@@ -267,7 +267,7 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
   const auto secondsSinceStart = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  pcl_ms_mpi::MpiUnitFarm exchange(job.communicator, [&](const std::string &stage) {
+  pcl_ms_mpi::MpiUnitFarm exchange(job.communicator, parameters, [&](const std::string &stage) {
     if (verbose)
       std::fprintf(stderr, "  all ranks: %s done, %.1f s elapsed\n", stage.c_str(),
                    secondsSinceStart());

@@ -7,8 +7,10 @@
 #include <chrono>
 #include <cstdint>
 #include <cstring>
+#include <future>
 #include <limits>
 #include <stdexcept>
+#include <thread>
 #include <type_traits>
 #include <utility>
 
@@ -180,8 +182,11 @@ bool receiveMessage(std::vector<char> &buffer, int &from, MPI_Comm communicator)
 
 } // namespace
 
-MpiUnitFarm::MpiUnitFarm(MPI_Comm communicator, std::function<void(const std::string &)> on_stage)
-    : communicator_(communicator), on_stage_(std::move(on_stage)) {
+MpiUnitFarm::MpiUnitFarm(MPI_Comm communicator, const pcl_ms::Parameters &parameters,
+                         std::function<void(const std::string &)> on_stage)
+    : communicator_(communicator), parameters_(parameters),
+      deadline_(parameters.time_limit_seconds), on_stage_(std::move(on_stage)) {
+  parameters_.progress = {}; // units report through meshInBuckets, not here
   MPI_Comm_size(communicator_, &size_);
 }
 
@@ -193,22 +198,43 @@ void MpiUnitFarm::stageDone(const std::string &stage) {
 void MpiUnitFarm::mesh(std::size_t count,
                        const std::function<pcl_ms::BucketTask(std::size_t)> &make,
                        const std::function<void(std::size_t, pcl_ms::BucketOutcome &&)> &done) {
-  std::size_t next = 0, in_flight = 0;
+  std::size_t next = 0, remote = 0;
   const auto sendNext = [&](int to) {
     bytes_sent_ += sendMessage(encodeTask(next, make(next)), to, communicator_);
     ++next;
-    ++in_flight;
+    ++remote;
   };
   // One unit per rank at a time: the next goes to whichever finishes first.
   for (int rank = 1; rank < size_ && next < count; ++rank)
     sendNext(rank);
+  std::future<pcl_ms::BucketOutcome> local;
+  std::size_t local_unit = 0;
   std::vector<char> buffer;
-  while (in_flight > 0) {
-    int from = MPI_ANY_SOURCE;
+  while (remote > 0 || local.valid() || next < count) {
+    if (!local.valid() && next < count) {
+      local_unit = next++;
+      local = std::async(std::launch::async, [this, task = make(local_unit)] {
+        return pcl_ms::meshBucket(task, parameters_, &deadline_);
+      });
+    }
+    if (local.valid() && local.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+      done(local_unit, local.get()); // rethrows the time limit
+      continue;
+    }
+    // Polled, not a blocking receive: Open MPI's spins a core, which
+    // rank 0's own unit needs.
+    int waiting = 0;
+    MPI_Status status;
+    MPI_Iprobe(MPI_ANY_SOURCE, size_tag, communicator_, &waiting, &status);
+    if (!waiting) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      continue;
+    }
+    int from = status.MPI_SOURCE;
     if (!receiveMessage(buffer, from, communicator_))
       throw std::runtime_error("rank " + std::to_string(from) + " sent no outcome");
     bytes_received_ += buffer.size();
-    --in_flight;
+    --remote;
     std::uint64_t unit = 0;
     pcl_ms::BucketOutcome outcome = decodeOutcome(buffer, unit);
     if (unit >= count)
@@ -234,6 +260,13 @@ ServedUnits serveUnits(MPI_Comm communicator, const pcl_ms::Parameters &paramete
   const pcl_ms::Deadline deadline(parameters.time_limit_seconds);
   std::vector<char> buffer;
   for (;;) {
+    // Waiting polls too: rank 0 finishes the surface while the others
+    // wait for the release, and a spinning receive would take its core.
+    for (int waiting = 0; !waiting;) {
+      MPI_Iprobe(0, size_tag, communicator, &waiting, MPI_STATUS_IGNORE);
+      if (!waiting)
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
     int from = 0;
     if (!receiveMessage(buffer, from, communicator))
       break;

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <pcl_ms/buckets.h>
+#include <pcl_ms/deadline.h>
 
 #include <mpi.h>
 
@@ -17,12 +18,14 @@
 namespace pcl_ms_mpi {
 
 /// Rank 0's side: a pcl_ms::BucketExchange whose farm sends units to ranks
-/// 1 .. N-1. Needs at least 2 ranks.
+/// 1 .. N-1 and meshes one at a time itself, on a thread of its own (only
+/// the calling thread calls MPI). With one rank there is no farm.
 class MpiUnitFarm : public pcl_ms::BucketExchange, public pcl_ms::UnitFarm {
 public:
-  /// `on_stage` runs after the buckets and after each seam level.
-  explicit MpiUnitFarm(MPI_Comm communicator,
-                       std::function<void(const std::string &)> on_stage = {});
+  /// `parameters` mesh rank 0's own units (a copy is kept); `on_stage` runs
+  /// after the buckets and after each seam level.
+  MpiUnitFarm(MPI_Comm communicator, const pcl_ms::Parameters &parameters,
+              std::function<void(const std::string &)> on_stage = {});
 
   pcl_ms::UnitFarm *farm() override { return size_ > 1 ? this : nullptr; }
   void stageDone(const std::string &stage) override;
@@ -36,6 +39,8 @@ public:
 
 private:
   MPI_Comm communicator_;
+  pcl_ms::Parameters parameters_;
+  pcl_ms::Deadline deadline_;
   int size_ = 1;
   std::function<void(const std::string &)> on_stage_;
   std::size_t bytes_sent_ = 0, bytes_received_ = 0;
