@@ -39,6 +39,9 @@
 #include <vector>
 
 #include <sys/resource.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 namespace {
 
@@ -430,6 +433,13 @@ int run(const Job &job, int argc, char **argv) {
 } // namespace
 
 int main(int argc, char **argv) {
+#ifdef __GLIBC__
+  // Blocks of 1 MB and more (unit messages, per-bucket triangles) are
+  // mapped and returned on free. Left to glibc's adaptive threshold they
+  // came from the heap, and the gaps they left raised rank 0's peak in the
+  // final stage (docs/algorithm.md, "Across processes").
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);
+#endif
   // Only the main thread calls MPI; TBB's workers mesh units between calls.
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
