@@ -34,6 +34,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
@@ -105,6 +106,7 @@ void printRankTable(const std::vector<RankFigures> &figures) {
 struct SliceStatus {
   int code = kSuccess;
   int all_finite = 1; // every point has finite x, y, z
+  int readers = 1;    // ranks that read a part
 };
 
 /// Every rank reads the records of its own byte range of a binary PCD and
@@ -115,9 +117,19 @@ template <typename PointT>
 SliceStatus readCloudInParts(const Job &job, const std::string &path,
                              const pcl_ms_mpi::BinaryCloudLayout &layout,
                              pcl::PointCloud<PointT> &points) {
-  const std::uint64_t begin = pcl_ms_mpi::firstRecordOf(job.rank, job.ranks, layout.points);
-  const std::uint64_t end = pcl_ms_mpi::firstRecordOf(job.rank + 1, job.ranks, layout.points);
+  // Without a shared filesystem the other ranks may not see the file (or
+  // see another): then rank 0 reads it all.
+  std::error_code code;
+  int sees = std::filesystem::file_size(path, code) == layout.file_size && !code;
+  int all_see = 0;
+  MPI_Allreduce(&sees, &all_see, 1, MPI_INT, MPI_MIN, job.communicator);
+  const int readers = all_see ? job.ranks : 1;
+  const auto firstOf = [&](int rank) {
+    return pcl_ms_mpi::firstRecordOf(std::min(rank, readers), readers, layout.points);
+  };
+  const std::uint64_t begin = firstOf(job.rank), end = firstOf(job.rank + 1);
   SliceStatus mine;
+  mine.readers = readers;
   std::vector<unsigned char> bytes;
   std::string error;
   if (!pcl_ms_mpi::readRecords(path, layout, begin, end, bytes, error)) {
@@ -126,6 +138,7 @@ SliceStatus readCloudInParts(const Job &job, const std::string &path,
     mine.code = pcl_ms_tools::kIoFailure;
   }
   SliceStatus all;
+  all.readers = readers;
   MPI_Allreduce(&mine.code, &all.code, 1, MPI_INT, MPI_MAX, job.communicator);
   if (all.code != kSuccess)
     return all;
@@ -151,9 +164,8 @@ SliceStatus readCloudInParts(const Job &job, const std::string &path,
       }
   }
   std::vector<unsigned char>().swap(bytes);
-  for (int r = 1; r < job.ranks; ++r) {
-    const std::uint64_t first = pcl_ms_mpi::firstRecordOf(r, job.ranks, layout.points);
-    const std::uint64_t last = pcl_ms_mpi::firstRecordOf(r + 1, job.ranks, layout.points);
+  for (int r = 1; r < readers; ++r) {
+    const std::uint64_t first = firstOf(r), last = firstOf(r + 1);
     if (job.rank == 0)
       pcl_ms_mpi::receiveBytes(points.data() + first, (last - first) * sizeof(PointT), r,
                                job.communicator);
@@ -211,9 +223,6 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
     if (verbose) {
       pcl::console::print_highlight("Reading ");
       print_value("%s ", options.input.c_str());
-      print_info("in ");
-      print_value("%d", job.ranks);
-      print_info(" parts ");
     }
     const auto read_start = std::chrono::steady_clock::now();
     read = readCloudInParts(job, options.input, input.layout, points);
@@ -230,7 +239,9 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
       print_value("%.1f", load_ms);
       print_info(" ms : ");
       print_value("%zu", points.size());
-      print_info(" points]\n");
+      print_info(" points, ");
+      print_value("%d", read.readers);
+      print_info(read.readers == 1 ? " part]\n" : " parts]\n");
       print_info("Available dimensions: ");
       print_value("%s\n", fields.c_str());
     }

@@ -140,6 +140,9 @@ bool describeBinaryPcd(const std::string &path, BinaryCloudLayout &layout, std::
 
 bool readRecords(const std::string &path, const BinaryCloudLayout &layout, std::uint64_t begin,
                  std::uint64_t end, std::vector<unsigned char> &bytes, std::string &error) {
+  bytes.clear();
+  if (begin == end) // a rank with no part need not see the file
+    return true;
   const std::uint64_t first = layout.data_offset + begin * layout.record_bytes;
   const std::uint64_t last = layout.data_offset + end * layout.record_bytes;
   std::error_code code;
