@@ -2,12 +2,13 @@
 // pcl_ms_reconstruct_mpi: pcl_ms_reconstruct across the ranks of an MPI job,
 // with the same options and the same triangles for any number of ranks.
 //
-// Rank 0 reads the cloud and broadcasts its points (the other ranks need no
-// access to the file). Every rank prepares the points and builds the bucket
-// tree the same way; each meshes its own buckets and seam zones, and the
-// triangles a zone needs go to the rank that owns it (pcl_ms::BucketExchange;
-// docs/algorithm.md, "Across processes"). Rank 0 ends with the whole
-// surface, finishes it (hole filling, orientation) and writes the mesh.
+// The ranks read their own byte ranges of a binary PCD and send them to
+// rank 0 (other formats: rank 0 reads). Rank 0 prepares the points, builds
+// the bucket tree and hands each bucket and seam zone as a task to a free
+// rank (pcl_ms_mpi::MpiUnitFarm), meshing one itself meanwhile; the other
+// ranks hold one unit at a time, never the cloud (docs/algorithm.md,
+// "Across processes"). Rank 0 finishes the surface (hole filling,
+// orientation) and writes the mesh.
 //
 // Failures: what every rank would see the same way (arguments, the file) is
 // agreed on and every rank exits with the same code; a failure on one rank
@@ -86,9 +87,9 @@ struct RankFigures {
 
 void printRankTable(const std::vector<RankFigures> &figures) {
   print_info("\nRanks:\n");
-  // "read": the peak once every rank has the points; "prepared": once they
-  // are prepared, before any bucket: what every rank pays for holding the
-  // whole cloud.
+  // "read": the peak once the points are in (rank 0: all of them, the
+  // others: their part until sent); "prepared": rank 0's once they are
+  // prepared, before any bucket; "reconstruct": the others' time meshing.
   print_info("  %-6s %14s %10s %14s %16s %10s %14s\n", "rank", "peak RSS (MB)", "read (MB)",
              "prepared (MB)", "reconstruct (s)", "sent (MB)", "received (MB)");
   double total_peak = 0;
