@@ -37,8 +37,9 @@ using namespace pcl_ms_tools;
 struct Options {
   std::string input, reference, out_dir = "compare_out";
   std::vector<Method> methods = allMethods();
-  int picture_size = 800;   // pixels, width and height of each method's picture
-  bool medial_axis = false; // also pcl_ms's medial axis: a PLY and a picture
+  int picture_size = 800;    // pixels, width and height of each method's picture
+  bool medial_axis = false;  // also pcl_ms's medial axis: a PLY and a picture
+  bool non_manifold = false; // pcl_ms with seams (Parameters::allow_non_manifold)
   bool quiet = false;
   bool help = false;
 };
@@ -47,7 +48,7 @@ void printHelp(const char *program) {
   std::printf(
       "Meshes a point cloud with pcl_ms and three other methods and compares the results.\n\n"
       "Usage: %s input [-gt reference_mesh] [-out DIR] [-methods list] [-picture_size N]\n"
-      "          [-medial_axis] [-q]\n\n"
+      "          [-medial_axis] [-non_manifold] [-q]\n\n"
       "  input         point cloud: .pcd, .ply, .xyz or .txt\n"
       "  -gt FILE      reference surface (.ply, .obj, .off, .vtk): adds triangle recall and\n"
       "                precision (vertices matched by position), distances and F-scores\n"
@@ -58,6 +59,8 @@ void printHelp(const char *program) {
       "                width and height of each method's picture in pixels (default 800)\n"
       "  -medial_axis  also write pcl_ms's medial axis: medial_axis.ply and a picture of its\n"
       "                nodes (those inside, if the surface has an inside) beside the surface\n"
+      "  -non_manifold pcl_ms allows non-manifold seams where sheets meet (its pictures draw\n"
+      "                edges with three or more triangles red, as every method's do)\n"
       "  -q            quiet: no progress, only warnings and errors\n"
       "  -h            this help\n\n"
       "Writes results.md, results.csv, <method>.ply, <method>.png and side_by_side.png.\n"
@@ -116,6 +119,8 @@ bool parseArguments(int argc, char **argv, Options &options, std::string &error)
       options.quiet = true;
     } else if (argument == "-medial_axis") {
       options.medial_axis = true;
+    } else if (argument == "-non_manifold") {
+      options.non_manifold = true;
     } else if (argument == "-gt" || argument == "-out" || argument == "-methods" ||
                argument == "-picture_size") {
       if (i + 1 >= argc) {
@@ -444,6 +449,7 @@ int run(int argc, char **argv) {
   // A depth frame's sensor is its viewpoint, as for the PCL class.
   PeerSettings settings;
   settings.viewpoint = sensorViewpoint(blob, sensor_origin);
+  settings.non_manifold = options.non_manifold;
   pcl::PointCloud<pcl::PointXYZ> points;
   const std::size_t skipped = finitePoints(blob, points);
   blob = pcl::PCLPointCloud2(); // only the positions are needed from here on

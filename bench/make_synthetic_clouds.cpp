@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 //
 // Writes the clouds of known topology and non-uniform density
-// (apps/common/synthetic_clouds.h) as binary PCD files, the scans organized
+// (src/tools/synthetic_clouds.h) as binary PCD files, the scans organized
 // and with their sensor pose in the VIEWPOINT field, and truth.csv with what
 // a correct reconstruction of each has. scripts/topology_table.sh meshes them.
 #include "mesh_report.h"

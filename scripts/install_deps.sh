@@ -23,7 +23,7 @@ PACKAGES=(
   # not built.
   openmpi-bin
   libopenmpi-dev
-  # Off-screen pictures (apps/common/render_mesh.cpp): Debian's VTK draws
+  # Off-screen pictures (src/tools/render_mesh.cpp): Debian's VTK draws
   # through GLX only, so headless machines get a private Xvfb, and Mesa's
   # software OpenGL (llvmpipe, loaded at run time) does the drawing. libpng
   # checks pictures before VTK reads them.

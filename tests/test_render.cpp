@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Tests of apps/common/render_mesh.h (suites Render*): pictures are rendered
+// Tests of src/tools/render_mesh.h (suites Render*): pictures are rendered
 // off-screen (a private Xvfb when there is no DISPLAY), read back with VTK's
 // PNG reader and checked pixel by pixel.
 #include "render_mesh.h"

@@ -1,26 +1,22 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Helpers shared by the core tests: bundled data and small hand-made clouds.
+// Helpers shared by the tests that use PCL: the core's helpers plus clouds
+// read through the tools' loader and views of PCL clouds.
 #pragma once
 
+#include "core/core_test_support.h"
+
 #include <pcl_ms/io.h>
-#include <pcl_ms/mesh_quality.h>
-#include <pcl_ms/reconstruct.h>
 
 #include <pcl/conversions.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
-#include <gtest/gtest.h>
-
-#include <cmath>
+#include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace pcl_ms_test {
-
-inline std::string dataPath(const std::string &name) {
-  return std::string(PCL_MS_DATA_DIR) + "/" + name;
-}
 
 inline pcl::PointCloud<pcl::PointXYZ>::Ptr loadXYZ(const std::string &name) {
   pcl::PCLPointCloud2 blob;
@@ -32,29 +28,6 @@ inline pcl::PointCloud<pcl::PointXYZ>::Ptr loadXYZ(const std::string &name) {
   return cloud;
 }
 
-struct ReferenceMesh {
-  std::vector<Eigen::Vector3d> vertices;
-  std::vector<pcl_ms::Triangle> triangles;
-};
-
-inline const ReferenceMesh &bunnyReference() {
-  static const ReferenceMesh mesh = [] {
-    ReferenceMesh loaded;
-    std::string error;
-    if (!pcl_ms::loadMesh(dataPath("bun_zipper.ply"), loaded.vertices, loaded.triangles, error))
-      throw std::runtime_error(error);
-    return loaded;
-  }();
-  return mesh;
-}
-
-inline std::vector<Eigen::Vector3d> positions(const std::vector<float> &xyz) {
-  std::vector<Eigen::Vector3d> result;
-  for (std::size_t i = 0; i + 2 < xyz.size(); i += 3)
-    result.emplace_back(xyz[i], xyz[i + 1], xyz[i + 2]);
-  return result;
-}
-
 template <typename PointT>
 std::vector<Eigen::Vector3d> positions(const pcl::PointCloud<PointT> &cloud) {
   std::vector<Eigen::Vector3d> result;
@@ -63,42 +36,12 @@ std::vector<Eigen::Vector3d> positions(const pcl::PointCloud<PointT> &cloud) {
   return result;
 }
 
-inline pcl_ms::PointView viewOf(const std::vector<float> &xyz) {
-  pcl_ms::PointView view;
-  view.xyz = xyz.data();
-  view.size = xyz.size() / 3;
-  return view;
-}
-
 template <typename PointT> pcl_ms::PointView viewOf(const pcl::PointCloud<PointT> &cloud) {
   pcl_ms::PointView view;
   view.xyz = &cloud[0].x;
   view.size = cloud.size();
   view.stride = sizeof(PointT);
   return view;
-}
-
-/// n points on a unit sphere, evenly spread (Fibonacci lattice).
-inline std::vector<float> fibonacciSphere(int n, double radius = 1.0,
-                                          Eigen::Vector3d centre = Eigen::Vector3d::Zero()) {
-  std::vector<float> xyz;
-  const double golden = M_PI * (3.0 - std::sqrt(5.0));
-  for (int i = 0; i < n; ++i) {
-    const double y = 1.0 - 2.0 * (i + 0.5) / n, r = std::sqrt(1.0 - y * y), phi = golden * i;
-    xyz.push_back(static_cast<float>(centre.x() + radius * r * std::cos(phi)));
-    xyz.push_back(static_cast<float>(centre.y() + radius * y));
-    xyz.push_back(static_cast<float>(centre.z() + radius * r * std::sin(phi)));
-  }
-  return xyz;
-}
-
-/// The manifold checks every reconstruction must pass.
-inline void expectCleanManifold(const pcl_ms::MeshTopologyReport &report) {
-  EXPECT_EQ(report.non_manifold_edges, 0u);
-  EXPECT_EQ(report.non_manifold_vertices, 0u);
-  EXPECT_EQ(report.degenerate_triangles, 0u);
-  EXPECT_EQ(report.duplicate_triangles, 0u);
-  EXPECT_EQ(report.invalid_triangles, 0u);
 }
 
 } // namespace pcl_ms_test

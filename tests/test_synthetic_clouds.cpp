@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The generators of apps/common/synthetic_clouds.h themselves (not the
+// The generators of src/tools/synthetic_clouds.h themselves (not the
 // reconstruction): determinism, point counts, the density ratios they
 // promise, and the geometry of the one-view scan.
 #include "synthetic_clouds.h"

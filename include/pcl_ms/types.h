@@ -9,14 +9,53 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace pcl_ms {
 
 using VertexIndex = std::uint32_t;
 using Triangle = std::array<VertexIndex, 3>;
+
+/// A read-only list of record numbers in whichever integer type the caller
+/// holds them: pcl::Indices is 32 or 64 bits, signed or not, depending on how
+/// PCL was built. Empty (and false) when no list is given.
+class IndexList {
+public:
+  IndexList() = default;
+  template <typename Integer>
+  explicit IndexList(const std::vector<Integer> &indices)
+      : data_(indices.data()), size_(indices.size()), bytes_(sizeof(Integer)),
+        signed_(std::is_signed_v<Integer>) {
+    static_assert(std::is_integral_v<Integer> && (sizeof(Integer) == 4 || sizeof(Integer) == 8),
+                  "indices must be 32- or 64-bit integers");
+  }
+
+  explicit operator bool() const { return data_ != nullptr; }
+  std::size_t size() const { return size_; }
+
+  /// Entry i; -1 for an unsigned entry too large for int64 (it is out of any
+  /// cloud's range either way).
+  std::int64_t operator[](std::size_t i) const {
+    if (bytes_ == 4)
+      return signed_ ? std::int64_t{static_cast<const std::int32_t *>(data_)[i]}
+                     : std::int64_t{static_cast<const std::uint32_t *>(data_)[i]};
+    if (signed_)
+      return static_cast<const std::int64_t *>(data_)[i];
+    const std::uint64_t entry = static_cast<const std::uint64_t *>(data_)[i];
+    const auto largest = static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
+    return entry > largest ? -1 : static_cast<std::int64_t>(entry);
+  }
+
+private:
+  const void *data_ = nullptr;
+  std::size_t size_ = 0;
+  std::uint8_t bytes_ = 4;
+  bool signed_ = true;
+};
 
 /// Read-only view of the user's points: `size` records, `stride` bytes apart,
 /// each starting with three consecutive floats x, y, z (true for every PCL
@@ -28,8 +67,9 @@ struct PointView {
   /// Optional normals, same layout rules (nx, ny, nz consecutive floats).
   const float *normals = nullptr;
   std::size_t normal_stride = 3 * sizeof(float);
-  /// Optional subset of records to use (like pcl::PCLBase::setIndices).
-  const std::vector<int> *indices = nullptr;
+  /// Optional subset of records to use (like pcl::PCLBase::setIndices);
+  /// the list must outlive the call.
+  IndexList indices;
 };
 
 /// How reconstruct() treats the initial triangles of a partial mesh or
@@ -211,8 +251,9 @@ struct Result {
   /// Distinct initial triangles that are in the output mesh (either mode).
   std::size_t initial_kept = 0;
   /// With Parameters::allow_non_manifold: the edges that hold three or more
-  /// triangles (user indices, smaller first, sorted), and the triangles the
-  /// seam pass added (they are in `triangles` too).
+  /// triangles (user indices, smaller first, sorted), and how many triangles
+  /// joined the finished surface along the seams: those on seam edges and
+  /// the seam pass's fillers (they are in `triangles` too).
   std::vector<std::array<VertexIndex, 2>> seam_edges;
   std::size_t seam_triangles = 0;
   BucketStatistics bucket_statistics;

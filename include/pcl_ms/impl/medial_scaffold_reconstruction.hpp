@@ -61,11 +61,11 @@ bool MedialScaffoldReconstruction<PointInT>::runCore(std::vector<pcl::Vertices> 
   // PCLBase fills indices_ with 0..n-1 when the user gave none; pass only a
   // real subset so the core can skip the indirection.
   if (indices_ && indices_->size() != input_->size())
-    view.indices = indices_.get();
+    view.indices = pcl_ms::IndexList(*indices_);
   else if (indices_) {
     for (std::size_t i = 0; i < indices_->size(); ++i)
-      if ((*indices_)[i] != static_cast<int>(i)) {
-        view.indices = indices_.get();
+      if (static_cast<std::size_t>((*indices_)[i]) != i) {
+        view.indices = pcl_ms::IndexList(*indices_);
         break;
       }
   }

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Stage 3: the growing surface mesh over the scaffold's candidates, with the
+// For stage 3: the growing surface mesh over the scaffold's candidates, with the
 // per-edge and per-vertex counts the manifold rules ask about in O(1).
 #pragma once
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Stage 4: greedy gap transforms (paper §3; docs/algorithm.md §3). Candidates
+// Stage 3: greedy gap transforms (paper §3; docs/algorithm.md section 3). Candidates
 // are accepted cheapest first under 2-manifold rules; accepted neighbours
 // change the costs; conflicts undo costlier earlier choices.
 #pragma once
@@ -48,8 +48,9 @@ public:
   /// without the scaffold's fixed triangles when `with_fixed` is false.
   std::vector<Triangle> triangles(bool with_fixed = true) const;
   /// With Parameters::allow_non_manifold, the triangles of the seam pass
-  /// (docs/algorithm.md, "Seams (opt-in)"), kept apart from triangles(): the
-  /// 2-manifold mesh is finished first and these join it afterwards.
+  /// and the mesh's triangles on seam edges (docs/algorithm.md, "Seams
+  /// (opt-in)"), kept apart from triangles(): the 2-manifold rest is
+  /// finished first and these join it afterwards.
   std::vector<Triangle> seamTriangles() const;
   const GreedyStatistics &statistics() const { return statistics_; }
 

@@ -1,22 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Far stray points: a few points at wildly different magnitudes must neither
 // slow the method down nor change the mesh of the rest of the cloud.
-#include "test_support.h"
+#include "core_test_support.h"
 
 #include <algorithm>
 #include <chrono>
 
 namespace {
-
-using pcl_ms_test::dataPath;
-
-std::vector<float> bunnyCoordinates() {
-  const auto cloud = pcl_ms_test::loadXYZ("bunny.pcd");
-  std::vector<float> xyz;
-  for (const auto &p : *cloud)
-    xyz.insert(xyz.end(), {p.x, p.y, p.z});
-  return xyz;
-}
 
 struct TimedResult {
   pcl_ms::Result result;
@@ -39,7 +29,7 @@ std::vector<pcl_ms::Triangle> sortedTriangles(std::vector<pcl_ms::Triangle> tria
 }
 
 TEST(FarPoints, StrayPointsAtHugeMagnitudesLeaveTheBunnyAsItIs) {
-  const std::vector<float> plain = bunnyCoordinates();
+  const std::vector<float> plain = pcl_ms_test::bunnyCoordinates();
   std::vector<float> with_strays = plain;
   // Appended, so the bunny's record indices stay the same.
   with_strays.insert(with_strays.end(),

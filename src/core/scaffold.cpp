@@ -1,4 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+// Stage 2, the medial scaffold (docs/algorithm.md section 2). In: distinct
+// points. Out: a MedialScaffold, i.e. the candidate triangles (Delaunay
+// facets within the local size limit) with their costs and neighbours, and
+// each point's local scale.
 #include <pcl_ms/costs.h>
 #include <pcl_ms/reconstruct.h>
 #include <pcl_ms/scaffold.h>

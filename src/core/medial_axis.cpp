@@ -8,6 +8,7 @@
 #include "indexed_delaunay.h"
 
 #include <CGAL/constructions/kernel_ftC3.h>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>

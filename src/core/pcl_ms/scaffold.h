@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Stage 1: the medial scaffold of a point cloud, read off its Delaunay
-// tetrahedralisation. Every Delaunay triangle is dual to a Voronoi edge (an
-// A1^3 shock curve) and is a candidate surface triangle.
+// Stage 2 (docs/algorithm.md section 2): the medial scaffold of a point cloud, read off its
+// Delaunay tetrahedralisation. Every Delaunay triangle is dual to a Voronoi edge (an A1^3 shock
+// curve) and is a candidate surface triangle.
 #pragma once
 
 #include <pcl_ms/local_scale.h>

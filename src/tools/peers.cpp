@@ -200,6 +200,7 @@ void runPclMs(const pcl::PointCloud<pcl::PointXYZ> &points, const PeerSettings &
   pcl_ms::Parameters parameters; // the library's defaults
   parameters.num_threads = settings.threads;
   parameters.viewpoint = settings.viewpoint;
+  parameters.allow_non_manifold = settings.non_manifold;
   stages.start("reconstruction");
   pcl_ms::Result result = pcl_ms::reconstruct(view, parameters);
   stages.stop();
@@ -213,6 +214,8 @@ void runPclMs(const pcl::PointCloud<pcl::PointXYZ> &points, const PeerSettings &
   run.triangles = std::move(result.triangles);
   run.configuration = "defaults (rho " + formatNumber(parameters.rho) + ", fill holes up to " +
                       std::to_string(parameters.fill_holes_max_edges) + " edges), no normals";
+  if (parameters.allow_non_manifold)
+    run.configuration += ", non-manifold seams allowed";
   if (parameters.viewpoint)
     run.configuration += ", viewpoint " + formatNumber((*parameters.viewpoint)[0]) + "," +
                          formatNumber((*parameters.viewpoint)[1]) + "," +

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Mesh readers of our own for .ply, .obj, .off and legacy .vtk, so that every
 // format reports the same kind of errors. Internal to the library: not
-// installed; loadMesh() in io.h is the public entry.
+// installed; loadMesh() in mesh_file.h is the entry for the tools.
 #pragma once
 
 #include <pcl_ms/types.h>

@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+// Stray points (docs/algorithm.md section 1). In: distinct points. Out: the
+// points far from the rest, and a centre they cannot move.
 #include "far_points.h"
 
 #include <algorithm>

@@ -1,4 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+// The pipeline (docs/algorithm.md, "Code layout" and section 1). In: the
+// user's PointView and Parameters (and initial triangles, if any). Out: a
+// Result whose triangles and loops use the user's record numbers. Prepares
+// the points, meshes them in one piece or in buckets, finishes the surface.
 #include <pcl_ms/buckets.h>
 #include <pcl_ms/finish.h>
 #include <pcl_ms/greedy.h>
@@ -113,7 +117,7 @@ const float *recordAt(const float *base, std::size_t stride, std::size_t record)
 /// same input gives the same mesh.
 PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_records,
                              Result &result) {
-  const std::size_t count = view.indices ? view.indices->size() : view.size;
+  const std::size_t count = view.indices ? view.indices.size() : view.size;
   result.input_points = count;
   if (count > 0 && !view.xyz)
     throw ReconstructionError("the point array is null");
@@ -125,7 +129,7 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
   for (std::size_t i = 0; i < count; ++i) {
     std::size_t record = i;
     if (view.indices) {
-      const int index = (*view.indices)[i];
+      const std::int64_t index = view.indices[i];
       if (index < 0 || static_cast<std::size_t>(index) >= view.size)
         throw ReconstructionError("index " + std::to_string(index) + " is outside the cloud of " +
                                   std::to_string(view.size) + " points");

@@ -54,6 +54,9 @@ struct PeerSettings {
   int poisson_depth = 8;
   /// pcl_ms threads; 1 so that every method runs single-threaded.
   int threads = 1;
+  /// pcl_ms with Parameters::allow_non_manifold (seams where sheets meet);
+  /// the other methods ignore it.
+  bool non_manifold = false;
 };
 
 struct StageTime {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Stage 5: turning the accepted triangles into a usable surface: holes of up
-// to k edges closed, each component oriented consistently where possible,
-// boundary loops traced. Works on a plain 2-manifold triangle list.
+// Stage 4 (docs/algorithm.md section 4): turning the accepted triangles into a usable surface:
+// holes of up to k edges closed, each component oriented consistently where possible, boundary
+// loops traced. Works on a plain 2-manifold triangle list.
 #pragma once
 
 #include <pcl_ms/local_scale.h>
@@ -56,8 +56,9 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
                               const Eigen::Vector3d *viewpoint = nullptr);
 
 /// The seam pass's triangles (docs/algorithm.md, "Seams (opt-in)") join a
-/// surface finished from the greedy's `greedy` triangles: exact repeats and
-/// those on an edge where the finish added a triangle are left out, each new
+/// surface finished from the greedy's `greedy` triangles: triangles the
+/// finish added (hole fills) on their edges are removed, exact repeats left
+/// out, each new
 /// triangle takes the orientation of its sheet across edges with two
 /// triangles (the finished ones keep theirs), components become the
 /// manifold sheets (joined across edges with exactly two triangles) and

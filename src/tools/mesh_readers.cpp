@@ -1,13 +1,18 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Mesh readers for .ply, .obj, .off and legacy .vtk (see mesh_readers.h).
+// Mesh readers for .ply, .obj, .off and legacy .vtk (see mesh_readers.h),
+// and loadMesh() on top of them (mesh_file.h).
 #include "mesh_readers.h"
 
 #include "io_parsing.h"
+
+#include <pcl_ms/mesh_file.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <exception>
+#include <filesystem>
 #include <limits>
 #include <sstream>
 #include <string_view>
@@ -679,5 +684,51 @@ bool loadVtkMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices
   return VtkReader(bytes).read(vertices, triangles, error);
 }
 
+bool readMeshFile(const std::string &path, std::vector<Eigen::Vector3d> &vertices,
+                  std::vector<Triangle> &triangles, std::string &reason) {
+  const std::string extension = fileExtension(path);
+  if (extension == ".ply")
+    return loadPlyMesh(path, vertices, triangles, reason);
+  if (extension == ".obj")
+    return loadObjMesh(path, vertices, triangles, reason);
+  if (extension == ".off")
+    return loadOffMesh(path, vertices, triangles, reason);
+  if (extension == ".vtk")
+    return loadVtkMesh(path, vertices, triangles, reason);
+  reason = unknownFormat(extension, "mesh", ".ply, .obj, .off or .vtk");
+  return false;
+}
+
 } // namespace io_detail
+
+std::string fileExtension(const std::string &path) {
+  return io_detail::toLower(std::filesystem::path(path).extension().string());
+}
+
+bool loadMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices,
+              std::vector<Triangle> &triangles, std::string &error) {
+  vertices.clear();
+  triangles.clear();
+  std::string reason;
+  bool ok = false;
+  try {
+    std::uintmax_t size = 0;
+    ok = io_detail::checkInputFile(path, size, reason) &&
+         io_detail::readMeshFile(path, vertices, triangles, reason);
+    if (ok && triangles.empty()) {
+      reason = "the file contains no faces";
+      ok = false;
+    }
+  } catch (const std::exception &exception) {
+    reason = std::string("unexpected failure: ") + exception.what();
+    ok = false;
+  }
+  if (!ok) {
+    vertices.clear();
+    triangles.clear();
+    error = path + ": " + reason;
+  }
+  return ok;
+}
+
 } // namespace pcl_ms

@@ -32,6 +32,8 @@
 #include "io_parsing.h"
 #include "mesh_readers.h"
 
+#include <pcl_ms/mesh_file.h>
+
 namespace pcl_ms {
 namespace {
 
@@ -471,20 +473,10 @@ bool checkMeshForSaving(const pcl::PolygonMesh &mesh, std::string &error) {
   return true;
 }
 
-std::string unknownFormat(const std::string &extension, const char *kind, const char *known) {
-  return (extension.empty() ? std::string("no file extension to tell the ") + kind + " format"
-                            : "unknown " + std::string(kind) + " format '" + extension + "'") +
-         " (use " + known + ")";
-}
-
 } // namespace
 
 // ---------------------------------------------------------------------------
 // Public functions
-
-std::string fileExtension(const std::string &path) {
-  return toLower(fs::path(path).extension().string());
-}
 
 bool hasNormals(const pcl::PCLPointCloud2 &cloud) {
   return isSingleFloatField(findField(cloud, "normal_x")) &&
@@ -493,22 +485,6 @@ bool hasNormals(const pcl::PCLPointCloud2 &cloud) {
 }
 
 namespace {
-
-/// The mesh reader for the file's extension (faces may be absent).
-bool readMeshFile(const std::string &path, std::vector<Eigen::Vector3d> &vertices,
-                  std::vector<Triangle> &triangles, std::string &reason) {
-  const std::string extension = fileExtension(path);
-  if (extension == ".ply")
-    return loadPlyMesh(path, vertices, triangles, reason);
-  if (extension == ".obj")
-    return loadObjMesh(path, vertices, triangles, reason);
-  if (extension == ".off")
-    return loadOffMesh(path, vertices, triangles, reason);
-  if (extension == ".vtk")
-    return loadVtkMesh(path, vertices, triangles, reason);
-  reason = unknownFormat(extension, "mesh", ".ply, .obj, .off or .vtk");
-  return false;
-}
 
 /// The vertices of an .obj, .off or .vtk mesh as a cloud, in file order;
 /// faces may be absent (a vertex-only OFF is a point cloud).
@@ -573,31 +549,6 @@ bool loadPointCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::st
   }
   if (sensor_origin)
     *sensor_origin = origin;
-  return ok;
-}
-
-bool loadMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices,
-              std::vector<Triangle> &triangles, std::string &error) {
-  vertices.clear();
-  triangles.clear();
-  std::string reason;
-  bool ok = false;
-  try {
-    std::uintmax_t size = 0;
-    ok = checkInputFile(path, size, reason) && readMeshFile(path, vertices, triangles, reason);
-    if (ok && triangles.empty()) {
-      reason = "the file contains no faces";
-      ok = false;
-    }
-  } catch (const std::exception &exception) {
-    reason = std::string("unexpected failure: ") + exception.what();
-    ok = false;
-  }
-  if (!ok) {
-    vertices.clear();
-    triangles.clear();
-    error = path + ": " + reason;
-  }
   return ok;
 }
 

@@ -66,6 +66,9 @@ bool isWholeNumberIn(double value, double low, double high);
 /// A number from a file for an error message, in the shortest form that reads back.
 std::string printableNumber(double value);
 
+/// "unknown <kind> format '.x' (use <known>)", or the same for no extension.
+std::string unknownFormat(const std::string &extension, const char *kind, const char *known);
+
 /// Checks that `path` names a readable, non-empty regular file.
 bool checkInputFile(const std::string &path, std::uintmax_t &size, std::string &error);
 /// The whole file, after checkInputFile().

@@ -1,4 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+// The growing mesh that stage 3 edits (docs/algorithm.md section 3). In:
+// triangle insertions and removals. Out: per-edge and per-vertex counts and
+// the manifold checks the greedy asks about.
 #include <pcl_ms/mesh_topology.h>
 
 #include <algorithm>

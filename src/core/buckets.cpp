@@ -1,4 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+// Large clouds in buckets (docs/algorithm.md section 5). In: distinct points.
+// Out: the triangles of every bucket and seam zone, stitched, before
+// finishing; each unit runs stages 2 and 3 (meshBucket).
 #include <pcl_ms/buckets.h>
 #include <pcl_ms/finish.h>
 #include <pcl_ms/greedy.h>

@@ -99,6 +99,12 @@ std::string printableNumber(double value) {
 }
 
 /// Checks that `path` names a readable, non-empty regular file.
+std::string unknownFormat(const std::string &extension, const char *kind, const char *known) {
+  return (extension.empty() ? std::string("no file extension to tell the ") + kind + " format"
+                            : "unknown " + std::string(kind) + " format '" + extension + "'") +
+         " (use " + known + ")";
+}
+
 bool checkInputFile(const std::string &path, std::uintmax_t &size, std::string &error) {
   std::error_code code;
   const fs::file_status status = fs::status(path, code);

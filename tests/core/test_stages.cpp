@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Unit tests of each core stage on configurations whose answers are known by hand.
-#include "test_support.h"
+#include "core_test_support.h"
 
 #include <pcl_ms/costs.h>
 #include <pcl_ms/finish.h>

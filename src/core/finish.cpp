@@ -1,4 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+// Stage 4, finishing (docs/algorithm.md section 4). In: the greedy's
+// triangles and the points. Out: a FinishedSurface: bow-ties split, small
+// holes filled, folds cut, components oriented, boundary loops traced.
 #include <pcl_ms/costs.h>
 #include <pcl_ms/finish.h>
 #include <pcl_ms/mesh_topology.h>
@@ -859,41 +862,45 @@ std::vector<std::array<VertexIndex, 2>> attachSeamTriangles(FinishedSurface &sur
                                                             const std::vector<Triangle> &seam,
                                                             const std::vector<Triangle> &greedy) {
   std::vector<Triangle> &triangles = surface.triangles;
-  const std::size_t finished = triangles.size();
+  std::size_t finished = triangles.size();
   auto key = [](VertexIndex a, VertexIndex b) {
     return std::make_pair(std::min(a, b), std::max(a, b));
   };
   {
-    // Where the finish added a triangle on an edge of a seam triangle (a
-    // hole filled), the seam pass did not see it: the seam triangle is left
-    // out, or the edge would hold one triangle too many.
-    std::map<std::pair<VertexIndex, VertexIndex>, int> added;
-    for (const Triangle &triangle : greedy)
+    // A triangle the finish added (a hole filled) on an edge of a seam
+    // triangle closed the gap that setting the seam triangles apart left:
+    // it goes, and the seam triangle takes its place.
+    std::set<Triangle> from_greedy;
+    for (Triangle triangle : greedy) {
+      std::sort(triangle.begin(), triangle.end());
+      from_greedy.insert(triangle);
+    }
+    std::set<std::pair<VertexIndex, VertexIndex>> seam_sides;
+    for (const Triangle &triangle : seam)
       for (int k = 0; k < 3; ++k)
-        --added[key(triangle[k], triangle[(k + 1) % 3])];
-    for (const Triangle &triangle : triangles)
-      for (int k = 0; k < 3; ++k) {
-        const auto found = added.find(key(triangle[k], triangle[(k + 1) % 3]));
-        if (found == added.end())
-          added[key(triangle[k], triangle[(k + 1) % 3])] = 1;
-        else
-          ++found->second;
-      }
-    // The hole filling may have closed a gap with one of them already.
+        seam_sides.insert(key(triangle[k], triangle[(k + 1) % 3]));
+    const auto filled_at_seam = [&](const Triangle &triangle) {
+      Triangle sorted = triangle;
+      std::sort(sorted.begin(), sorted.end());
+      if (from_greedy.count(sorted))
+        return false;
+      for (int k = 0; k < 3; ++k)
+        if (seam_sides.count(key(triangle[k], triangle[(k + 1) % 3])))
+          return true;
+      return false;
+    };
+    triangles.erase(std::remove_if(triangles.begin(), triangles.end(), filled_at_seam),
+                    triangles.end());
+    finished = triangles.size();
     std::set<Triangle> present;
     for (Triangle triangle : triangles) {
       std::sort(triangle.begin(), triangle.end());
       present.insert(triangle);
     }
     for (const Triangle &triangle : seam) {
-      bool clash = false;
-      for (int k = 0; k < 3; ++k) {
-        const auto found = added.find(key(triangle[k], triangle[(k + 1) % 3]));
-        clash |= found != added.end() && found->second > 0;
-      }
       Triangle sorted = triangle;
       std::sort(sorted.begin(), sorted.end());
-      if (!clash && present.insert(sorted).second)
+      if (present.insert(sorted).second)
         triangles.push_back(triangle);
     }
   }

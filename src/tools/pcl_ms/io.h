@@ -6,6 +6,7 @@
 // PCL's readers are trusted with them).
 #pragma once
 
+#include <pcl_ms/mesh_file.h> // loadMesh, fileExtension
 #include <pcl_ms/types.h>
 
 #include <Eigen/Core>
@@ -16,9 +17,6 @@
 #include <vector>
 
 namespace pcl_ms {
-
-/// Lower-case extension of `path` including the dot (".pcd"), or "" if none.
-std::string fileExtension(const std::string &path);
 
 /// Loads a point cloud chosen by extension (case-insensitive):
 ///  - .pcd: ascii, binary or binary_compressed (PCL's reader);
@@ -34,13 +32,6 @@ std::string fileExtension(const std::string &path);
 /// (zero for the other formats and on failure).
 bool loadPointCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::string &error,
                     Eigen::Vector4f *sensor_origin = nullptr);
-
-/// Loads a triangle mesh (for instance a reference surface) from .ply, .obj,
-/// .off or legacy .vtk (POLYDATA, ascii or binary). Polygons with more than
-/// three corners are fan-triangulated. Fails on meshes without faces and on
-/// faces that reference missing vertices.
-bool loadMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices,
-              std::vector<Triangle> &triangles, std::string &error);
 
 /// True when `path` has an extension saveMesh() can write (.ply, .vtk, .obj).
 bool isMeshOutputSupported(const std::string &path);
