@@ -2,21 +2,24 @@
 // pcl_ms_reconstruct_mpi: pcl_ms_reconstruct across the ranks of an MPI job,
 // with the same options and the same triangles for any number of ranks.
 //
-// Rank 0 reads the cloud and broadcasts its points (the other ranks need no
-// access to the file). Every rank prepares the points and builds the bucket
-// tree the same way; each meshes its own buckets and seam zones, and the
-// triangles a zone needs go to the rank that owns it (pcl_ms::BucketExchange;
-// docs/algorithm.md, "Across processes"). Rank 0 ends with the whole
-// surface, finishes it (hole filling, orientation) and writes the mesh.
+// The ranks read their own byte ranges of a binary PCD and send them to
+// rank 0 (other formats: rank 0 reads). Rank 0 prepares the points, builds
+// the bucket tree and hands each bucket and seam zone as a task to a free
+// rank (pcl_ms_mpi::MpiUnitFarm), meshing one itself meanwhile; the other
+// ranks hold one unit at a time, never the cloud (docs/algorithm.md,
+// "Across processes"). Rank 0 finishes the surface (hole filling,
+// orientation) and writes the mesh.
 //
 // Failures: what every rank would see the same way (arguments, the file) is
 // agreed on and every rank exits with the same code; a failure on one rank
 // alone (a unit's exception, the time limit) prints its line and aborts the
 // job, so no rank waits for it.
 #include "mpi_bucket_exchange.h"
+#include "mpi_cloud_reader.h"
 #include "reconstruct_cli.h"
 #include "tool_support.h"
 
+#include <pcl_ms/io.h>
 #include <pcl_ms/reconstruct.h>
 
 #include <pcl/conversions.h>
@@ -26,15 +29,21 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <sys/resource.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 namespace {
 
@@ -72,51 +81,119 @@ double peakResidentMegabytes() {
 
 /// What each rank reports to rank 0 for the summary.
 struct RankFigures {
-  double peak_mb = 0, prepared_mb = 0, reconstruct_seconds = 0, sent_mb = 0, received_mb = 0;
+  double peak_mb = 0, read_mb = 0, prepared_mb = 0, reconstruct_seconds = 0, sent_mb = 0,
+         received_mb = 0;
 };
 
 void printRankTable(const std::vector<RankFigures> &figures) {
   print_info("\nRanks:\n");
-  // "prepared": the peak once the points are prepared, before any bucket:
-  // what every rank pays for holding the whole cloud.
-  print_info("  %-6s %14s %14s %16s %14s %14s\n", "rank", "peak RSS (MB)", "prepared (MB)",
-             "reconstruct (s)", "sent (MB)", "received (MB)");
+  // "read": the peak once the points are in (rank 0: all of them, the
+  // others: their part until sent); "prepared": rank 0's once they are
+  // prepared, before any bucket; "reconstruct": the others' time meshing.
+  print_info("  %-6s %14s %10s %14s %16s %10s %14s\n", "rank", "peak RSS (MB)", "read (MB)",
+             "prepared (MB)", "reconstruct (s)", "sent (MB)", "received (MB)");
   double total_peak = 0;
   for (std::size_t r = 0; r < figures.size(); ++r) {
     print_info("  %-6zu ", r);
-    print_value("%14.1f %14.1f %16.2f %14.1f %14.1f\n", figures[r].peak_mb, figures[r].prepared_mb,
-                figures[r].reconstruct_seconds, figures[r].sent_mb, figures[r].received_mb);
+    print_value("%14.1f %10.1f %14.1f %16.2f %10.1f %14.1f\n", figures[r].peak_mb,
+                figures[r].read_mb, figures[r].prepared_mb, figures[r].reconstruct_seconds,
+                figures[r].sent_mb, figures[r].received_mb);
     total_peak += figures[r].peak_mb;
   }
   pcl_ms_tools::printRow("peak RSS, all ranks", "%10.1f", total_peak);
 }
 
-/// Broadcasts rank 0's points and meshes them on every rank; rank 0 gets
-/// the triangles. The points are freed on return, before rank 0 builds the
-/// output mesh.
-template <typename PointT>
-pcl_ms::Result meshAs(const Job &job, const pcl::PCLPointCloud2 &cloud,
-                      const pcl_ms::Parameters &parameters,
-                      pcl_ms_mpi::MpiBucketExchange &exchange) {
-  pcl::PointCloud<PointT> points;
-  if (job.rank == 0) {
-    SilencePclMessages silence;
-    pcl::fromPCLPointCloud2(cloud, points);
-  }
-  std::uint64_t count = points.size();
-  MPI_Bcast(&count, 1, MPI_UINT64_T, 0, job.communicator);
-  points.resize(count);
-  pcl_ms_mpi::broadcastBytes(points.data(), count * sizeof(PointT), 0, job.communicator);
+/// What a rank found reading its byte range.
+struct SliceStatus {
+  int code = kSuccess;
+  int all_finite = 1; // every point has finite x, y, z
+  int readers = 1;    // ranks that read a part
+};
 
+/// Every rank reads the records of its own byte range of a binary PCD and
+/// sends them to rank 0, which alone ends with all points (docs/algorithm.md,
+/// "Across processes"). A range the file does not hold fails on its rank,
+/// with the reason there, and every rank returns kIoFailure.
+template <typename PointT>
+SliceStatus readCloudInParts(const Job &job, const std::string &path,
+                             const pcl_ms_mpi::BinaryCloudLayout &layout,
+                             pcl::PointCloud<PointT> &points) {
+  // Without a shared filesystem the other ranks may not see the file (or
+  // see another): then rank 0 reads it all.
+  std::error_code code;
+  int sees = std::filesystem::file_size(path, code) == layout.file_size && !code;
+  int all_see = 0;
+  MPI_Allreduce(&sees, &all_see, 1, MPI_INT, MPI_MIN, job.communicator);
+  const int readers = all_see ? job.ranks : 1;
+  const auto firstOf = [&](int rank) {
+    return pcl_ms_mpi::firstRecordOf(std::min(rank, readers), readers, layout.points);
+  };
+  const std::uint64_t begin = firstOf(job.rank), end = firstOf(job.rank + 1);
+  SliceStatus mine;
+  mine.readers = readers;
+  std::vector<unsigned char> bytes;
+  std::string error;
+  if (!pcl_ms_mpi::readRecords(path, layout, begin, end, bytes, error)) {
+    fail(pcl_ms_tools::kIoFailure,
+         job.ranks > 1 ? "rank " + std::to_string(job.rank) + ": " + error : error);
+    mine.code = pcl_ms_tools::kIoFailure;
+  }
+  SliceStatus all;
+  all.readers = readers;
+  MPI_Allreduce(&mine.code, &all.code, 1, MPI_INT, MPI_MAX, job.communicator);
+  if (all.code != kSuccess)
+    return all;
+  // Rank 0 holds the whole cloud, the others their range only.
+  const std::uint64_t first_held = job.rank == 0 ? 0 : begin;
+  points.resize(job.rank == 0 ? layout.points : end - begin);
+  auto field = [&](std::size_t record, std::uint32_t offset) {
+    float value;
+    std::memcpy(&value, bytes.data() + record * layout.record_bytes + offset, sizeof value);
+    return value;
+  };
+  for (std::uint64_t i = begin; i < end; ++i) {
+    PointT &point = points[i - first_held];
+    point.x = field(i - begin, layout.xyz[0]);
+    point.y = field(i - begin, layout.xyz[1]);
+    point.z = field(i - begin, layout.xyz[2]);
+    mine.all_finite &= std::isfinite(point.x) && std::isfinite(point.y) && std::isfinite(point.z);
+    if constexpr (pcl::traits::has_normal_v<PointT>)
+      if (layout.hasNormals()) {
+        point.normal_x = field(i - begin, static_cast<std::uint32_t>(layout.normal[0]));
+        point.normal_y = field(i - begin, static_cast<std::uint32_t>(layout.normal[1]));
+        point.normal_z = field(i - begin, static_cast<std::uint32_t>(layout.normal[2]));
+      }
+  }
+  std::vector<unsigned char>().swap(bytes);
+  for (int r = 1; r < readers; ++r) {
+    const std::uint64_t first = firstOf(r), last = firstOf(r + 1);
+    if (job.rank == 0)
+      pcl_ms_mpi::receiveBytes(points.data() + first, (last - first) * sizeof(PointT), r,
+                               job.communicator);
+    else if (job.rank == r)
+      pcl_ms_mpi::sendBytes(points.data(), points.size() * sizeof(PointT), 0, job.communicator);
+  }
+  if (job.rank != 0)
+    pcl::PointCloud<PointT>().swap(points);
+  MPI_Allreduce(&mine.all_finite, &all.all_finite, 1, MPI_INT, MPI_MIN, job.communicator);
+  return all;
+}
+
+/// Rank 0: meshes `points`, with the other ranks meshing the units it
+/// hands out, and frees them.
+template <typename PointT>
+pcl_ms::Result meshPoints(const Job &job, pcl::PointCloud<PointT> &&points,
+                          const pcl_ms::Parameters &parameters, pcl_ms_mpi::MpiUnitFarm &exchange) {
+  const pcl::PointCloud<PointT> owned = std::move(points);
   // As pcl::MedialScaffoldReconstruction passes them: no indices, normals
   // from the point type.
   pcl_ms::PointView view;
-  view.xyz = points.empty() ? nullptr : &points[0].x;
-  view.size = points.size();
+  view.xyz = owned.empty() ? nullptr : &owned[0].x;
+  view.size = owned.size();
   view.stride = sizeof(PointT);
   if constexpr (pcl::traits::has_normal_v<PointT>) {
     if (parameters.use_normals) {
-      view.normals = points.empty() ? nullptr : &points[0].normal_x;
+      view.normals = owned.empty() ? nullptr : &owned[0].normal_x;
       view.normal_stride = sizeof(PointT);
     }
   }
@@ -125,6 +202,175 @@ pcl_ms::Result meshAs(const Job &job, const pcl::PCLPointCloud2 &cloud,
   } catch (const std::exception &error) {
     abortJob(job, kReconstructionFailure, std::string("reconstruction failed: ") + error.what());
   }
+}
+
+/// How the input reaches the ranks; rank 0 decides, every rank gets it.
+struct Input {
+  pcl_ms_mpi::BinaryCloudLayout layout;
+  int in_parts = 0; // each rank reads its own byte range of a binary PCD
+};
+
+/// The points on every rank, meshed; rank 0 saves the mesh. `cloud` is
+/// rank 0's loaded file when the ranks do not read it in parts.
+template <typename PointT>
+int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &options,
+                    pcl_ms::Parameters parameters, const Input &input, pcl::PCLPointCloud2 &cloud,
+                    const std::string &fields, double load_ms) {
+  const bool on_rank_zero = job.rank == 0;
+  const bool verbose = on_rank_zero && !options.quiet;
+  pcl::PointCloud<PointT> points;
+  SliceStatus read;
+  if (input.in_parts) {
+    if (verbose) {
+      pcl::console::print_highlight("Reading ");
+      print_value("%s ", options.input.c_str());
+    }
+    const auto read_start = std::chrono::steady_clock::now();
+    read = readCloudInParts(job, options.input, input.layout, points);
+    if (read.code != kSuccess) {
+      if (verbose)
+        print_info("[failed]\n");
+      return read.code;
+    }
+    load_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - read_start)
+            .count();
+    if (verbose) {
+      print_info("[done, ");
+      print_value("%.1f", load_ms);
+      print_info(" ms : ");
+      print_value("%zu", points.size());
+      print_info(" points, ");
+      print_value("%d", read.readers);
+      print_info(read.readers == 1 ? " part]\n" : " parts]\n");
+      print_info("Available dimensions: ");
+      print_value("%s\n", fields.c_str());
+    }
+  } else if (on_rank_zero) {
+    SilencePclMessages silence;
+    pcl::fromPCLPointCloud2(cloud, points);
+  }
+  const double read_mb = peakResidentMegabytes();
+
+  if (!on_rank_zero) {
+    // The other ranks mesh the units rank 0 sends them, one at a time.
+    pcl_ms_mpi::ServedUnits served;
+    try {
+      served = pcl_ms_mpi::serveUnits(job.communicator, parameters);
+    } catch (const std::exception &error) {
+      abortJob(job, kReconstructionFailure, std::string("reconstruction failed: ") + error.what());
+    }
+    RankFigures mine{peakResidentMegabytes(),
+                     read_mb,
+                     0,
+                     served.seconds,
+                     static_cast<double>(served.bytes_sent) / (1 << 20),
+                     static_cast<double>(served.bytes_received) / (1 << 20)};
+    MPI_Gather(&mine, sizeof(RankFigures), MPI_BYTE, nullptr, 0, MPI_BYTE, 0, job.communicator);
+    return statusOfRankZero(job, kSuccess);
+  }
+
+  if (verbose) {
+    pcl_ms_tools::printReconstructStart(options, parameters);
+    print_info("on ");
+    print_value("%d", job.ranks);
+    print_info(" ranks ");
+    std::fflush(stdout);                                // the progress lines go to stderr
+    parameters.progress = pcl_ms_tools::ProgressLine(); // rank 0's own units
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const auto secondsSinceStart = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  pcl_ms_mpi::MpiUnitFarm exchange(job.communicator, parameters, [&](const std::string &stage) {
+    if (verbose)
+      std::fprintf(stderr, "  all ranks: %s done, %.1f s elapsed\n", stage.c_str(),
+                   secondsSinceStart());
+  });
+  pcl_ms::Result result = meshPoints(job, std::move(points), parameters, exchange);
+  exchange.release(); // the other ranks are done
+  const double reconstruct_seconds = secondsSinceStart();
+  if (verbose) {
+    print_info("[done, ");
+    print_value("%.1f", reconstruct_seconds * 1e3);
+    print_info(" ms : ");
+    print_value("%zu", result.triangles.size());
+    print_info(" triangles]\n");
+  }
+
+  // Rank 0 writes. A binary PCD of x y z only, all finite, into a PLY: the
+  // vertices go from the input to the output a block at a time, so rank 0
+  // never holds the cloud (the same bytes as PCL's writer). Otherwise it
+  // loads the file now, after the meshing has freed the points.
+  double save_ms = 0;
+  int status = kSuccess;
+  std::string error;
+  if (on_rank_zero) {
+    const bool streamed = input.in_parts && input.layout.xyz_only && read.all_finite &&
+                          input.layout.height == 1 &&
+                          pcl_ms::fileExtension(options.output) == ".ply";
+    if (streamed) {
+      if (verbose) {
+        pcl::console::print_highlight("Saving ");
+        print_value("%s ", options.output.c_str());
+      }
+      const auto save_start = std::chrono::steady_clock::now();
+      if (!pcl_ms_mpi::writePlyFromInput(options.output, options.input, input.layout,
+                                         result.triangles, error))
+        status = pcl_ms_tools::kIoFailure;
+      save_ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - save_start)
+              .count();
+      if (verbose) {
+        if (status == kSuccess) {
+          print_info("[done, ");
+          print_value("%.1f", save_ms);
+          print_info(" ms]\n");
+        } else {
+          print_info("[failed]\n");
+        }
+      }
+    } else {
+      if (input.in_parts) {
+        SilencePclMessages silence;
+        Eigen::Vector4f origin;
+        if (!pcl_ms::loadPointCloud(options.input, cloud, error, &origin)) {
+          error = options.input + ": " + error;
+          status = pcl_ms_tools::kIoFailure;
+        }
+      }
+      if (status == kSuccess) {
+        std::vector<pcl::Vertices> polygons(result.triangles.size());
+        for (std::size_t t = 0; t < result.triangles.size(); ++t)
+          polygons[t].vertices.assign(result.triangles[t].begin(), result.triangles[t].end());
+        status = pcl_ms_tools::saveReconstructedMesh(options, std::move(cloud), std::move(polygons),
+                                                     save_ms, error);
+      }
+    }
+    if (status == kSuccess)
+      status = pcl_ms_tools::saveReconstructedMedialAxis(options, result, error);
+  }
+  RankFigures mine{peakResidentMegabytes(),
+                   read_mb,
+                   result.peak_memory.prepare / 1048576.0,
+                   reconstruct_seconds,
+                   static_cast<double>(exchange.bytesSent()) / (1 << 20),
+                   static_cast<double>(exchange.bytesReceived()) / (1 << 20)};
+  std::vector<RankFigures> figures(on_rank_zero ? job.ranks : 0);
+  MPI_Gather(&mine, sizeof(RankFigures), MPI_BYTE, figures.data(), sizeof(RankFigures), MPI_BYTE, 0,
+             job.communicator);
+  status = statusOfRankZero(job, status);
+  if (status != kSuccess)
+    return on_rank_zero ? fail(status, error) : status;
+  if (verbose) {
+    pcl_ms_tools::printReconstructReport(result, load_ms, save_ms);
+    printRankTable(figures);
+    // Where rank 0's memory goes beyond the others': it alone finishes.
+    const pcl_ms::StagePeakMemory &peaks = result.peak_memory;
+    pcl_ms_tools::printRow("rank 0 MB, meshed", "%10.1f", peaks.greedy / 1048576.0);
+    pcl_ms_tools::printRow("rank 0 MB, finished", "%10.1f", peaks.finish / 1048576.0);
+  }
+  return kSuccess;
 }
 
 int run(const Job &job, int argc, char **argv) {
@@ -150,22 +396,39 @@ int run(const Job &job, int argc, char **argv) {
       !reason.empty())
     return on_rank_zero ? fail(kBadArguments, reason) : kBadArguments;
 
-  const bool verbose = on_rank_zero && !options.quiet;
   pcl::PCLPointCloud2 cloud;
+  Input input;
+  std::string fields;
   double load_ms = 0;
   int status = kSuccess;
   if (on_rank_zero) {
     status = pcl_ms_tools::checkMeshOutput(options.output, error);
     if (status == kSuccess)
       status = pcl_ms_tools::checkMedialAxisOutput(options.medial_axis, error);
-    if (status == kSuccess)
+    // A binary PCD is read in parts, unless normals are to be estimated
+    // (on the whole cloud) or asked for and absent (the loader says so).
+    if (status == kSuccess && options.estimate_normals == 0 &&
+        pcl_ms_mpi::describeBinaryPcd(options.input, input.layout, fields) &&
+        (!options.normals || input.layout.hasNormals())) {
+      input.in_parts = 1;
+      if (!parameters.viewpoint && !options.no_viewpoint) {
+        pcl::PCLPointCloud2 header;
+        header.width = input.layout.width;
+        header.height = input.layout.height;
+        const Eigen::Vector4f origin(input.layout.origin[0], input.layout.origin[1],
+                                     input.layout.origin[2], 0);
+        parameters.viewpoint = pcl_ms_tools::sensorViewpoint(header, origin);
+      }
+    } else if (status == kSuccess) {
       status = pcl_ms_tools::loadReconstructInput(options, parameters, cloud, load_ms, error);
+    }
   }
   status = statusOfRankZero(job, status);
   if (status != kSuccess)
     return on_rank_zero ? fail(status, error) : status;
+  MPI_Bcast(&input, sizeof input, MPI_BYTE, 0, job.communicator);
 
-  // The viewpoint may come from the file, which only rank 0 read.
+  // The viewpoint may come from the file's header, which only rank 0 read.
   double viewpoint[4] = {parameters.viewpoint ? 1.0 : 0.0, 0, 0, 0};
   if (parameters.viewpoint)
     std::copy(parameters.viewpoint->begin(), parameters.viewpoint->end(), viewpoint + 1);
@@ -173,68 +436,22 @@ int run(const Job &job, int argc, char **argv) {
   if (viewpoint[0] != 0)
     parameters.viewpoint = {{viewpoint[1], viewpoint[2], viewpoint[3]}};
 
-  if (verbose) {
-    pcl_ms_tools::printReconstructStart(options, parameters);
-    print_info("on ");
-    print_value("%d", job.ranks);
-    print_info(" ranks ");
-    std::fflush(stdout);                                // the progress lines go to stderr
-    parameters.progress = pcl_ms_tools::ProgressLine(); // rank 0's own units
-  }
-  const auto start = std::chrono::steady_clock::now();
-  const auto secondsSinceStart = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  };
-  pcl_ms_mpi::MpiBucketExchange exchange(job.communicator, [&](const std::string &stage) {
-    if (verbose)
-      std::fprintf(stderr, "  all ranks: %s done, %.1f s elapsed\n", stage.c_str(),
-                   secondsSinceStart());
-  });
-  const pcl_ms::Result result = parameters.use_normals
-                                    ? meshAs<pcl::PointNormal>(job, cloud, parameters, exchange)
-                                    : meshAs<pcl::PointXYZ>(job, cloud, parameters, exchange);
-  std::vector<pcl::Vertices> polygons(result.triangles.size());
-  for (std::size_t t = 0; t < result.triangles.size(); ++t)
-    polygons[t].vertices.assign(result.triangles[t].begin(), result.triangles[t].end());
-  const double reconstruct_seconds = secondsSinceStart();
-  if (verbose) {
-    print_info("[done, ");
-    print_value("%.1f", reconstruct_seconds * 1e3);
-    print_info(" ms : ");
-    print_value("%zu", polygons.size());
-    print_info(" triangles]\n");
-  }
-
-  double save_ms = 0;
-  if (on_rank_zero) {
-    status = pcl_ms_tools::saveReconstructedMesh(options, std::move(cloud), std::move(polygons),
-                                                 save_ms, error);
-    if (status == kSuccess)
-      status = pcl_ms_tools::saveReconstructedMedialAxis(options, result, error);
-  }
-  RankFigures mine{peakResidentMegabytes(), result.peak_memory.prepare / 1048576.0,
-                   reconstruct_seconds, static_cast<double>(exchange.bytesSent()) / (1 << 20),
-                   static_cast<double>(exchange.bytesReceived()) / (1 << 20)};
-  std::vector<RankFigures> figures(on_rank_zero ? job.ranks : 0);
-  MPI_Gather(&mine, sizeof(RankFigures), MPI_BYTE, figures.data(), sizeof(RankFigures), MPI_BYTE, 0,
-             job.communicator);
-  status = statusOfRankZero(job, status);
-  if (status != kSuccess)
-    return on_rank_zero ? fail(status, error) : status;
-  if (verbose) {
-    pcl_ms_tools::printReconstructReport(result, load_ms, save_ms);
-    printRankTable(figures);
-    // Where rank 0's memory goes beyond the others': it alone finishes.
-    const pcl_ms::StagePeakMemory &peaks = result.peak_memory;
-    pcl_ms_tools::printRow("rank 0 MB, meshed", "%10.1f", peaks.greedy / 1048576.0);
-    pcl_ms_tools::printRow("rank 0 MB, finished", "%10.1f", peaks.finish / 1048576.0);
-  }
-  return kSuccess;
+  return parameters.use_normals ? loadMeshAndSave<pcl::PointNormal>(job, options, parameters, input,
+                                                                    cloud, fields, load_ms)
+                                : loadMeshAndSave<pcl::PointXYZ>(job, options, parameters, input,
+                                                                 cloud, fields, load_ms);
 }
 
 } // namespace
 
 int main(int argc, char **argv) {
+#ifdef __GLIBC__
+  // Blocks of 1 MB and more (unit messages, per-bucket triangles) are
+  // mapped and returned on free. Left to glibc's adaptive threshold they
+  // came from the heap, and the gaps they left raised rank 0's peak in the
+  // final stage (docs/algorithm.md, "Across processes").
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);
+#endif
   // Only the main thread calls MPI; TBB's workers mesh units between calls.
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);

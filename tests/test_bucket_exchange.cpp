@@ -142,6 +142,63 @@ TEST(BucketExchange, ProcessesGiveTheOneProcessMesh) {
   }
 }
 
+/// A farm that builds a batch of tasks, meshes them on threads and hands
+/// the outcomes back last first: the order and place of meshing must not
+/// matter. It records how many units were in flight at most.
+class BatchFarm : public pcl_ms::BucketExchange, public pcl_ms::UnitFarm {
+public:
+  explicit BatchFarm(const pcl_ms::Parameters &parameters) : parameters_(parameters) {}
+  pcl_ms::UnitFarm *farm() override { return this; }
+  void mesh(std::size_t count, const std::function<pcl_ms::BucketTask(std::size_t)> &make,
+            const std::function<void(std::size_t, pcl_ms::BucketOutcome &&)> &done) override {
+    constexpr std::size_t batch = 3;
+    for (std::size_t begin = 0; begin < count; begin += batch) {
+      const std::size_t end = std::min(count, begin + batch);
+      std::vector<pcl_ms::BucketTask> tasks;
+      for (std::size_t i = begin; i < end; ++i)
+        tasks.push_back(make(i));
+      most_in_flight = std::max(most_in_flight, tasks.size());
+      std::vector<pcl_ms::BucketOutcome> outcomes(tasks.size());
+      std::vector<std::thread> threads;
+      for (std::size_t k = 0; k < tasks.size(); ++k)
+        threads.emplace_back([&, k] { outcomes[k] = pcl_ms::meshBucket(tasks[k], parameters_); });
+      for (std::thread &thread : threads)
+        thread.join();
+      for (std::size_t k = tasks.size(); k-- > 0;)
+        done(begin + k, std::move(outcomes[k]));
+      units += tasks.size();
+    }
+  }
+  std::size_t units = 0, most_in_flight = 0;
+
+private:
+  pcl_ms::Parameters parameters_;
+};
+
+TEST(BucketExchange, AFarmGivesTheOneProcessMesh) {
+  const auto cloud = loadXYZ("bunny.pcd");
+  pcl_ms::Parameters parameters;
+  parameters.bucket_points = 4000;
+  const pcl_ms::Result reference = pcl_ms::reconstruct(viewOf(*cloud), parameters);
+  const pcl_ms::BucketStatistics &expected = reference.bucket_statistics;
+  ASSERT_GE(expected.buckets, 8u);
+  ASSERT_GT(expected.seam_triangles, 0u);
+
+  BatchFarm farm(parameters);
+  const pcl_ms::Result result = pcl_ms::reconstruct(viewOf(*cloud), parameters, farm);
+  EXPECT_EQ(result.triangles, reference.triangles);
+  EXPECT_EQ(result.boundary_loops, reference.boundary_loops);
+  EXPECT_EQ(result.d_med, reference.d_med);
+  const pcl_ms::BucketStatistics &got = result.bucket_statistics;
+  EXPECT_EQ(got.margin_points, expected.margin_points);
+  EXPECT_EQ(got.seam_points, expected.seam_points);
+  EXPECT_EQ(got.seam_triangles, expected.seam_triangles);
+  // Every bucket went through the farm, and every zone with points to mesh.
+  EXPECT_GE(farm.units, expected.buckets + 1);
+  EXPECT_LE(farm.units, expected.buckets + expected.seam_zones);
+  EXPECT_LE(farm.most_in_flight, 3u);
+}
+
 TEST(BucketExchange, LeavesAreSharedInContiguousRanges) {
   // 10 leaves on 4 processes: 3, 2, 3, 2 (rounded down multiples).
   std::vector<int> owners;

@@ -348,16 +348,31 @@ public:
     surface_.local_scale.assign(points_.size(), 0.0f);
     std::vector<BucketOutcome> leaf_outcomes(leaves.size());
     std::vector<std::size_t> margin_points(leaves.size(), 0);
-    arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, own_leaves.size(), 1),
-                        [&](const tbb::blocked_range<std::size_t> &range) {
-                          for (std::size_t k = range.begin(); k != range.end(); ++k) {
-                            const std::size_t i = own_leaves[k];
-                            margin_points[i] = meshLeaf(nodes[leaves[i]], leaf_outcomes[i]);
-                            progress.unitDone();
-                          }
-                        });
-    });
+    if (UnitFarm *farm = exchange_.farm()) {
+      // Only the units in flight keep their members.
+      std::vector<std::vector<VertexIndex>> members(own_leaves.size());
+      farm->mesh(
+          own_leaves.size(),
+          [&](std::size_t k) { return leafTask(nodes[leaves[own_leaves[k]]], members[k]); },
+          [&](std::size_t k, BucketOutcome &&outcome) {
+            const std::size_t i = own_leaves[k];
+            leaf_outcomes[i] = std::move(outcome);
+            margin_points[i] = keepLeaf(nodes[leaves[i]], leaf_outcomes[i], members[k]);
+            std::vector<VertexIndex>().swap(members[k]);
+            progress.unitDone();
+          });
+    } else {
+      arena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, own_leaves.size(), 1),
+                          [&](const tbb::blocked_range<std::size_t> &range) {
+                            for (std::size_t k = range.begin(); k != range.end(); ++k) {
+                              const std::size_t i = own_leaves[k];
+                              margin_points[i] = meshLeaf(nodes[leaves[i]], leaf_outcomes[i]);
+                              progress.unitDone();
+                            }
+                          });
+      });
+    }
     // Per leaf: d_med, failed, margin points; only the owner's are non-zero.
     std::vector<double> leaf_figures(3 * leaves.size(), 0.0);
     std::string first_error;
@@ -410,15 +425,36 @@ public:
       exchange_.moveTriangles(transfers);
       std::vector<BucketOutcome> outcomes(level.size());
       std::vector<std::size_t> zone_points(level.size(), 0);
-      arena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, level.size(), 1),
-                          [&](const tbb::blocked_range<std::size_t> &range) {
-                            for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                              zone_points[i] = stitch(nodes[level[i]], outcomes[i]);
-                              progress.unitDone();
-                            }
-                          });
-      });
+      if (UnitFarm *farm = exchange_.farm()) {
+        // Zones of one level are planned before any is stitched: planning
+        // reads only the zone's own subtree and the scales, fixed by now.
+        std::vector<Zone> zones(level.size());
+        std::vector<std::size_t> meshed;
+        for (std::size_t i = 0; i < level.size(); ++i) {
+          zones[i] = planZone(nodes[level[i]]);
+          if (zones[i].core_points >= 3)
+            meshed.push_back(i);
+        }
+        farm->mesh(
+            meshed.size(), [&](std::size_t k) { return std::move(zones[meshed[k]].task); },
+            [&](std::size_t k, BucketOutcome &&outcome) {
+              outcomes[meshed[k]] = std::move(outcome);
+            });
+        for (std::size_t i = 0; i < level.size(); ++i) {
+          zone_points[i] = keepZone(nodes[level[i]], zones[i], outcomes[i]);
+          progress.unitDone();
+        }
+      } else {
+        arena.execute([&] {
+          tbb::parallel_for(tbb::blocked_range<std::size_t>(0, level.size(), 1),
+                            [&](const tbb::blocked_range<std::size_t> &range) {
+                              for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                                zone_points[i] = stitch(nodes[level[i]], outcomes[i]);
+                                progress.unitDone();
+                              }
+                            });
+        });
+      }
       for (std::size_t i = 0; i < level.size(); ++i) {
         addTimings(outcomes[i]);
         seam_figures[0] += static_cast<double>(zone_points[i]);
@@ -482,36 +518,50 @@ private:
   }
 
   /// A bucket: its points plus those within the margin around its region.
-  /// Returns how many margin points it meshed.
-  std::size_t meshLeaf(Node &leaf, BucketOutcome &outcome) {
+  /// `members` gets the task's points, ascending.
+  BucketTask leafTask(const Node &leaf, std::vector<VertexIndex> &members) const {
     const std::uint32_t leaf_id = leaf.first_leaf;
-    const std::vector<VertexIndex> members =
-        tree_.gather(leaf.region.expanded(leaf_margin_[leaf_id]));
+    members = tree_.gather(leaf.region.expanded(leaf_margin_[leaf_id]));
     BucketTask task = makeTask(members);
     task.core.resize(members.size());
     for (std::size_t i = 0; i < members.size(); ++i)
       task.core[i] = tree_.leafOf(members[i]) == leaf_id;
-    outcome = meshBucket(task, parameters_, deadline_);
+    return task;
+  }
+
+  /// Keeps a bucket's outcome; returns how many margin points it meshed.
+  std::size_t keepLeaf(Node &leaf, BucketOutcome &outcome,
+                       const std::vector<VertexIndex> &members) {
+    const std::uint32_t leaf_id = leaf.first_leaf;
     leaf.triangles = toGlobal(outcome.triangles, members);
     markMayPinch(outcome.cut_vertices, members);
     // Each point's scale is the one its own bucket measured, where its
     // neighbourhood is complete; seams reuse it. Buckets own disjoint points.
     if (!outcome.local_scale.empty())
       for (std::size_t i = 0; i < members.size(); ++i)
-        if (task.core[i])
+        if (tree_.leafOf(members[i]) == leaf_id)
           surface_.local_scale[members[i]] = outcome.local_scale[i];
     outcome.local_scale = {};
     return members.size() - leaf.points.size();
   }
 
-  /// The zone along node's split plane: the subtree's points within reach
-  /// of the plane (core), and points of other subtrees within the margin
-  /// around the node's region. A triangle across the plane is shorter than
-  /// rho times the largest local scale near it, so that is the zone's half
-  /// width; a sparse part's can exceed the buckets' margin.
-  /// Triangles of the subtree that touch the core are fixed; their corners
-  /// outside the zone are frozen. Returns the number of core points.
-  std::size_t stitch(Node &node, BucketOutcome &outcome) {
+  std::size_t meshLeaf(Node &leaf, BucketOutcome &outcome) {
+    std::vector<VertexIndex> members;
+    const BucketTask task = leafTask(leaf, members);
+    outcome = meshBucket(task, parameters_, deadline_);
+    return keepLeaf(leaf, outcome, members);
+  }
+
+  /// A seam zone planned: its points and, with 3 core points or more, the
+  /// task to mesh.
+  struct Zone {
+    std::vector<VertexIndex> members;
+    std::vector<bool> core;
+    std::size_t core_points = 0;
+    BucketTask task;
+  };
+
+  Zone planZone(Node &node) {
     // The widest margin of the subtree's buckets.
     const double margin = *std::max_element(leaf_margin_.begin() + node.first_leaf,
                                             leaf_margin_.begin() + node.end_leaf);
@@ -531,12 +581,13 @@ private:
       in_zone[v] = true;
     auto inZone = [&](VertexIndex v) { return in_zone[v]; };
 
-    std::vector<Triangle> subtree_triangles;
+    Zone planned;
     std::vector<Triangle> fixed;
     std::vector<VertexIndex> frozen;
-    std::size_t core_points = 0;
     for (VertexIndex v : zone)
-      core_points += tree_.inSubtree(v, node);
+      planned.core_points += tree_.inSubtree(v, node);
+    if (planned.core_points < 3)
+      return planned;
     for (int child : node.children) {
       for (const Triangle &triangle : nodes_()[child].triangles) {
         bool touches = false;
@@ -552,51 +603,74 @@ private:
     }
     std::sort(frozen.begin(), frozen.end());
     frozen.erase(std::unique(frozen.begin(), frozen.end()), frozen.end());
-    std::vector<VertexIndex> members;
+    std::vector<VertexIndex> &members = planned.members;
     members.reserve(zone.size() + frozen.size());
     std::merge(zone.begin(), zone.end(), frozen.begin(), frozen.end(), std::back_inserter(members));
 
+    BucketTask &task = planned.task;
+    task = makeTask(members);
+    task.d_med = surface_.d_med;
+    task.local_scale.reserve(members.size());
+    for (VertexIndex v : members)
+      task.local_scale.push_back(surface_.local_scale[v]);
+    task.core.resize(members.size());
+    task.frozen.resize(members.size());
+    for (std::size_t i = 0; i < members.size(); ++i) {
+      const bool is_frozen = std::binary_search(frozen.begin(), frozen.end(), members[i]);
+      task.frozen[i] = is_frozen;
+      task.core[i] = !is_frozen && tree_.inSubtree(members[i], node);
+    }
+    planned.core = task.core;
+    auto localIndex = [&](VertexIndex v) {
+      return static_cast<VertexIndex>(std::lower_bound(members.begin(), members.end(), v) -
+                                      members.begin());
+    };
+    task.fixed_triangles.reserve(fixed.size());
+    for (const Triangle &triangle : fixed)
+      task.fixed_triangles.push_back(
+          {localIndex(triangle[0]), localIndex(triangle[1]), localIndex(triangle[2])});
+    return planned;
+  }
+
+  /// The subtree's triangles, then the seam's, in a fixed order. Returns
+  /// the number of core points.
+  std::size_t keepZone(Node &node, const Zone &zone, BucketOutcome &outcome) {
     std::vector<Triangle> added;
-    if (core_points >= 3) {
-      BucketTask task = makeTask(members);
-      task.d_med = surface_.d_med;
-      task.local_scale.reserve(members.size());
-      for (VertexIndex v : members)
-        task.local_scale.push_back(surface_.local_scale[v]);
-      task.core.resize(members.size());
-      task.frozen.resize(members.size());
-      for (std::size_t i = 0; i < members.size(); ++i) {
-        const bool is_frozen = std::binary_search(frozen.begin(), frozen.end(), members[i]);
-        task.frozen[i] = is_frozen;
-        task.core[i] = !is_frozen && tree_.inSubtree(members[i], node);
-      }
-      auto localIndex = [&](VertexIndex v) {
-        return static_cast<VertexIndex>(std::lower_bound(members.begin(), members.end(), v) -
-                                        members.begin());
-      };
-      task.fixed_triangles.reserve(fixed.size());
-      for (const Triangle &triangle : fixed)
-        task.fixed_triangles.push_back(
-            {localIndex(triangle[0]), localIndex(triangle[1]), localIndex(triangle[2])});
-      outcome = meshBucket(task, parameters_, deadline_);
-      added = toGlobal(outcome.triangles, members);
-      markMayPinch(outcome.cut_vertices, members);
-      for (std::size_t i = 0; i < members.size(); ++i)
-        if (task.core[i])
-          may_pinch_[members[i]] = 1;
+    if (zone.core_points >= 3) {
+      added = toGlobal(outcome.triangles, zone.members);
+      markMayPinch(outcome.cut_vertices, zone.members);
+      for (std::size_t i = 0; i < zone.members.size(); ++i)
+        if (zone.core[i])
+          may_pinch_[zone.members[i]] = 1;
     } else {
       outcome.error = "too few points";
     }
-
-    // The subtree's triangles, then the seam's, in a fixed order.
     std::vector<Triangle> &merged = node.triangles;
+    // Sized once: at the root this is the whole surface, and growing it by
+    // doubling would hold up to three times its size while copying.
+    merged.reserve(nodes_()[node.children[0]].triangles.size() +
+                   nodes_()[node.children[1]].triangles.size() + added.size());
     for (int child : node.children) {
       std::vector<Triangle> &part = nodes_()[child].triangles;
       merged.insert(merged.end(), part.begin(), part.end());
       std::vector<Triangle>().swap(part);
     }
     merged.insert(merged.end(), added.begin(), added.end());
-    return core_points;
+    return zone.core_points;
+  }
+
+  /// The zone along node's split plane: the subtree's points within reach
+  /// of the plane (core), and points of other subtrees within the margin
+  /// around the node's region. A triangle across the plane is shorter than
+  /// rho times the largest local scale near it, so that is the zone's half
+  /// width; a sparse part's can exceed the buckets' margin.
+  /// Triangles of the subtree that touch the core are fixed; their corners
+  /// outside the zone are frozen. Returns the number of core points.
+  std::size_t stitch(Node &node, BucketOutcome &outcome) {
+    Zone zone = planZone(node);
+    if (zone.core_points >= 3)
+      outcome = meshBucket(zone.task, parameters_, deadline_);
+    return keepZone(node, zone, outcome);
   }
 
   std::vector<Node> &nodes_() { return tree_.nodes(); }

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -79,6 +80,20 @@ struct BucketedSurface {
   double delaunay_seconds = 0, scaffold_seconds = 0, greedy_seconds = 0;
 };
 
+/// Meshes units somewhere else (docs/algorithm.md, "Across processes"):
+/// the process that plans the buckets and seams builds each unit's task and
+/// hands it out, so whoever meshes it holds that unit's points only.
+class UnitFarm {
+public:
+  virtual ~UnitFarm() = default;
+  /// Meshes units 0 .. count - 1: make(i) gives unit i's task, done(i, o)
+  /// takes meshBucket's outcome for it. Both are called on the calling
+  /// thread, make(i) before done(i), in any order over i; few units are
+  /// in flight at once.
+  virtual void mesh(std::size_t count, const std::function<BucketTask(std::size_t)> &make,
+                    const std::function<void(std::size_t, BucketOutcome &&)> &done) = 0;
+};
+
 /// Shares the buckets and seam zones of meshInBuckets among cooperating
 /// processes that all hold the same points (docs/algorithm.md, "Across
 /// processes"). The default is one process doing everything. Process r owns
@@ -104,6 +119,9 @@ public:
   virtual void moveTriangles(const std::vector<Transfer> &) {}
   /// Called on every process after the buckets and after each seam level.
   virtual void stageDone(const std::string & /*stage*/) {}
+  /// Not null: this (single) process plans every unit and the farm meshes
+  /// them, instead of sharing them by owner as above.
+  virtual UnitFarm *farm() { return nullptr; }
 };
 
 /// The process that meshes leaf number `leaf` of `leaves`.

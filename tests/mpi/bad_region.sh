@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
+# Usage: bad_region.sh BUILD_DIR MPIEXEC RANKS BINARY_PCD
+# Each rank reads its own byte range of a binary PCD. With the file's last
+# records cut off, only the last rank's range is bad: that rank must say so
+# (naming itself and the file), the others must not claim an error of their
+# own, every rank must exit with 2 (file error), quickly, and no mesh may be
+# written.
+set -euo pipefail
+build=$1 mpiexec=$2 ranks=$3 input=$4
+source "$(dirname "${BASH_SOURCE[0]}")/job_setup.sh"
+
+# 100 bytes fewer: part of the last record or records, none of the others'.
+head -c $(($(stat -c %s "$input") - 100)) "$input" > "$work/cut.pcd"
+started=$SECONDS
+"$mpiexec" "${mpirun_flags[@]}" -np "$ranks" bash -c \
+  '"$0" "$1" "$2" -bucket_points 4000; echo "$?" > "$3/exit.$OMPI_COMM_WORLD_RANK"' \
+  "$build/pcl_ms_reconstruct_mpi" "$work/cut.pcd" "$work/out.ply" "$work" \
+  > "$work/stdout.txt" 2> "$work/stderr.txt" || true
+took=$((SECONDS - started))
+cat "$work/stderr.txt"
+[[ -e $work/out.ply ]] && { echo "FAIL: a mesh was written"; exit 1; }
+last=$((ranks - 1))
+grep -q "^error: \(rank $last: \)\?.*cut.pcd: truncated PCD file" "$work/stderr.txt" ||
+  { echo "FAIL: no 'error:' line from rank $last naming the file"; exit 1; }
+if ((ranks > 1)) && grep -v "rank $last:" "$work/stderr.txt" | grep -q '^error:'; then
+  echo "FAIL: a rank whose range is whole reported an error"
+  exit 1
+fi
+grep -q 'Reconstructing' "$work/stdout.txt" && { echo "FAIL: meshing started"; exit 1; }
+for ((rank = 0; rank < ranks; ++rank)); do
+  [[ -e $work/exit.$rank ]] || { echo "FAIL: rank $rank did not exit"; exit 1; }
+  code=$(cat "$work/exit.$rank")
+  [[ $code == 2 ]] || { echo "FAIL: rank $rank exited with $code, expected 2 (file error)"; exit 1; }
+done
+((took <= 20)) || { echo "FAIL: the job took $took s"; exit 1; }
+echo "rank $last's range was cut short: all $ranks ranks exited with 2 within $took s"
