@@ -98,11 +98,23 @@ private:
   int process_;
 };
 
+/// The bunny in buckets of 4,000 points, as one process meshes it: the
+/// reference the shared runs must match.
+struct BucketedBunny {
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud = loadXYZ("bunny.pcd");
+  pcl_ms::Parameters parameters = [] {
+    pcl_ms::Parameters bucketed;
+    bucketed.bucket_points = 4000;
+    return bucketed;
+  }();
+  pcl_ms::Result reference = pcl_ms::reconstruct(viewOf(*cloud), parameters);
+};
+
 TEST(BucketExchange, ProcessesGiveTheOneProcessMesh) {
-  const auto cloud = loadXYZ("bunny.pcd");
-  pcl_ms::Parameters parameters;
-  parameters.bucket_points = 4000;
-  const pcl_ms::Result reference = pcl_ms::reconstruct(viewOf(*cloud), parameters);
+  const BucketedBunny bunny;
+  const auto &cloud = bunny.cloud;
+  const pcl_ms::Parameters &parameters = bunny.parameters;
+  const pcl_ms::Result &reference = bunny.reference;
   const pcl_ms::BucketStatistics &expected = reference.bucket_statistics;
   ASSERT_GE(expected.buckets, 8u);
   ASSERT_GT(expected.seam_triangles, 0u);
@@ -176,10 +188,10 @@ private:
 };
 
 TEST(BucketExchange, AFarmGivesTheOneProcessMesh) {
-  const auto cloud = loadXYZ("bunny.pcd");
-  pcl_ms::Parameters parameters;
-  parameters.bucket_points = 4000;
-  const pcl_ms::Result reference = pcl_ms::reconstruct(viewOf(*cloud), parameters);
+  const BucketedBunny bunny;
+  const auto &cloud = bunny.cloud;
+  const pcl_ms::Parameters &parameters = bunny.parameters;
+  const pcl_ms::Result &reference = bunny.reference;
   const pcl_ms::BucketStatistics &expected = reference.bucket_statistics;
   ASSERT_GE(expected.buckets, 8u);
   ASSERT_GT(expected.seam_triangles, 0u);
