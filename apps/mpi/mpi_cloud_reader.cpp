@@ -119,7 +119,9 @@ bool describeBinaryPcd(const std::string &path, BinaryCloudLayout &layout, std::
     }
     offset += bytes * count;
   }
-  if (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0)
+  // More records than the file could hold: rank 0's guarded loader reports
+  // it, and record offsets below cannot overflow.
+  if (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0 || points > size / offset)
     return false;
   found.data_offset = static_cast<std::uint64_t>(in.tellg());
   found.points = points;
