@@ -4,9 +4,8 @@
 // finishing; each unit runs stages 2 and 3 (meshBucket).
 #include <pcl_ms/buckets.h>
 #include <pcl_ms/finish.h>
-#include <pcl_ms/greedy.h>
+#include <pcl_ms/mesh_points.h>
 #include <pcl_ms/reconstruct.h>
-#include <pcl_ms/scaffold.h>
 
 #include "threads.h"
 
@@ -713,7 +712,6 @@ BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters,
     return outcome;
   }
   try {
-    const Clock::time_point start = Clock::now();
     ScaffoldOptions options;
     options.rho = parameters.rho;
     options.num_threads = 1;
@@ -725,18 +723,17 @@ BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters,
     options.frozen_vertices = task.frozen.empty() ? nullptr : &task.frozen;
     if (deadline)
       deadline->check("the buckets");
-    MedialScaffold scaffold = buildMedialScaffold(task.points, options);
-    if (deadline)
-      deadline->check("the buckets");
-    outcome.d_med = scaffold.d_med;
-    outcome.local_scale = scaffold.local_scale;
-    outcome.delaunay_seconds = scaffold.delaunay_seconds;
-    outcome.scaffold_seconds = secondsSince(start) - scaffold.delaunay_seconds;
-
-    const Clock::time_point greedy_start = Clock::now();
-    GreedyMesher mesher(scaffold, task.points, parameters, deadline);
-    mesher.run();
-    for (const Triangle &triangle : mesher.triangles(false)) {
+    MeshedPoints meshed =
+        meshPoints(task.points, options, parameters, deadline, false, [&](const MedialScaffold &) {
+          if (deadline)
+            deadline->check("the buckets");
+        });
+    outcome.d_med = meshed.d_med;
+    outcome.local_scale = std::move(meshed.local_scale);
+    outcome.delaunay_seconds = meshed.delaunay_seconds;
+    outcome.scaffold_seconds = meshed.scaffold_seconds;
+    outcome.greedy_seconds = meshed.greedy_seconds;
+    for (const Triangle &triangle : meshed.triangles) {
       if (task.core[triangle[0]] && task.core[triangle[1]] && task.core[triangle[2]]) {
         outcome.triangles.push_back(triangle);
         continue;
@@ -749,7 +746,6 @@ BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters,
     outcome.cut_vertices.erase(
         std::unique(outcome.cut_vertices.begin(), outcome.cut_vertices.end()),
         outcome.cut_vertices.end());
-    outcome.greedy_seconds = secondsSince(greedy_start);
   } catch (const TimeLimitExceeded &) {
     throw; // the whole run stops, not just this unit
   } catch (const ReconstructionError &error) {

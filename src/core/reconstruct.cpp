@@ -5,10 +5,9 @@
 // the points, meshes them in one piece or in buckets, finishes the surface.
 #include <pcl_ms/buckets.h>
 #include <pcl_ms/finish.h>
-#include <pcl_ms/greedy.h>
 #include <pcl_ms/medial_axis.h>
+#include <pcl_ms/mesh_points.h>
 #include <pcl_ms/reconstruct.h>
-#include <pcl_ms/scaffold.h>
 
 #include "far_points.h"
 #include "morton.h"
@@ -401,7 +400,6 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
       return result;
     }
   } else {
-    stage = Clock::now();
     ScaffoldOptions options;
     options.rho = parameters.rho;
     options.num_threads = parameters.num_threads;
@@ -410,34 +408,33 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
     options.fixed_triangles = fixed.empty() ? nullptr : &fixed;
     options.preferred_triangles = preferred.empty() ? nullptr : &preferred;
     deadline.check("the preparation");
-    MedialScaffold scaffold = buildMedialScaffold(prepared.positions, options);
-    deadline.check("the scaffold");
-    result.timings.delaunay = scaffold.delaunay_seconds;
-    result.timings.scaffold = secondsSince(stage) - scaffold.delaunay_seconds;
-    result.planar = scaffold.planar;
-    result.d_med = scaffold.d_med;
-    result.d_max = scaffold.d_max;
-    result.candidates_type1 = scaffold.type1;
-    result.candidates_type2 = scaffold.type2;
-    result.candidates_type3 = scaffold.type3;
-    result.candidates_oversize = scaffold.oversize;
-    result.initial_oversize = scaffold.preferred_oversize;
-    result.initial_invalid += scaffold.preferred_degenerate;
-    result.peak_memory.scaffold = std::max(result.peak_memory.prepare, peakResidentBytes());
-
-    stage = Clock::now();
-    GreedyMesher mesher(scaffold, prepared.positions, parameters, &deadline);
-    mesher.run();
-    triangles = mesher.triangles();
-    seam_triangles = mesher.seamTriangles();
+    MeshedPoints meshed = meshPoints(prepared.positions, options, parameters, &deadline, true,
+                                     [&](const MedialScaffold &scaffold) {
+                                       deadline.check("the scaffold");
+                                       result.planar = scaffold.planar;
+                                       result.d_med = scaffold.d_med;
+                                       result.d_max = scaffold.d_max;
+                                       result.candidates_type1 = scaffold.type1;
+                                       result.candidates_type2 = scaffold.type2;
+                                       result.candidates_type3 = scaffold.type3;
+                                       result.candidates_oversize = scaffold.oversize;
+                                       result.initial_oversize = scaffold.preferred_oversize;
+                                       result.initial_invalid += scaffold.preferred_degenerate;
+                                       result.peak_memory.scaffold = std::max(
+                                           result.peak_memory.prepare, peakResidentBytes());
+                                     });
+    result.timings.delaunay = meshed.delaunay_seconds;
+    result.timings.scaffold = meshed.scaffold_seconds;
+    triangles = std::move(meshed.triangles);
+    seam_triangles = std::move(meshed.seam_triangles);
     if (!seam_triangles.empty())
       greedy_triangles = triangles;
-    local_scale = std::move(scaffold.local_scale);
-    result.pass1 = mesher.statistics().pass1;
-    result.pass2 = mesher.statistics().pass2;
-    result.cleanup_undone = mesher.statistics().cleanup_undone;
-    result.swapped_pairs = mesher.statistics().swapped_pairs;
-    result.timings.greedy = secondsSince(stage);
+    local_scale = std::move(meshed.local_scale);
+    result.pass1 = meshed.greedy.pass1;
+    result.pass2 = meshed.greedy.pass2;
+    result.cleanup_undone = meshed.greedy.cleanup_undone;
+    result.swapped_pairs = meshed.greedy.swapped_pairs;
+    result.timings.greedy = meshed.greedy_seconds;
     result.peak_memory.greedy = std::max(result.peak_memory.scaffold, peakResidentBytes());
   }
 
