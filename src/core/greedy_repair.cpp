@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
+#include <string>
 
 namespace pcl_ms {
 namespace {
@@ -32,7 +34,10 @@ EdgeIndex GreedyMesher::Impl::edgeBetween(CandidateIndex t, VertexIndex a, Verte
     if ((p == a && q == b) || (p == b && q == a))
       return candidate.edges[k];
   }
-  return candidate.edges[0];
+  // Callers pass two corners of t; anything else is a broken invariant,
+  // which must stop the run rather than quietly use some edge.
+  throw std::logic_error("GreedyMesher: vertices " + std::to_string(a) + " and " +
+                         std::to_string(b) + " are not an edge of candidate " + std::to_string(t));
 }
 
 /// The candidate (a, b, apex), where a and b are the ends of edge e, or
