@@ -22,19 +22,20 @@ using Triangle = std::array<VertexIndex, 3>;
 
 /// A read-only list of record numbers in whichever integer type the caller
 /// holds them: pcl::Indices is 32 or 64 bits, signed or not, depending on how
-/// PCL was built. Empty (and false) when no list is given.
+/// PCL was built.
 class IndexList {
 public:
   IndexList() = default;
   template <typename Integer>
   explicit IndexList(const std::vector<Integer> &indices)
       : data_(indices.data()), size_(indices.size()), bytes_(sizeof(Integer)),
-        signed_(std::is_signed_v<Integer>) {
+        signed_(std::is_signed_v<Integer>), given_(true) {
     static_assert(std::is_integral_v<Integer> && (sizeof(Integer) == 4 || sizeof(Integer) == 8),
                   "indices must be 32- or 64-bit integers");
   }
 
-  explicit operator bool() const { return data_ != nullptr; }
+  /// Whether a list was given; an empty one selects no record.
+  explicit operator bool() const { return given_; }
   std::size_t size() const { return size_; }
 
   /// Entry i; -1 for an unsigned entry too large for int64 (it is out of any
@@ -55,6 +56,7 @@ private:
   std::size_t size_ = 0;
   std::uint8_t bytes_ = 4;
   bool signed_ = true;
+  bool given_ = false;
 };
 
 /// Read-only view of the user's points: `size` records, `stride` bytes apart,

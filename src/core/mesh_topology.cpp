@@ -33,7 +33,9 @@ void MeshTopology::add(CandidateIndex t) {
   const Candidate &candidate = scaffold_.candidates[t];
   for (int k = 0; k < 3; ++k) {
     auto &slots = edge_slots_[candidate.edges[k]];
-    assert(slots[1] == no_candidate && "the 2-manifold edge rule: a third triangle on an edge");
+    // A removal may leave an edge's one triangle in either slot.
+    assert((slots[0] == no_candidate || slots[1] == no_candidate) &&
+           "the 2-manifold edge rule: a third triangle on an edge");
     const int before = (slots[0] != no_candidate) + (slots[1] != no_candidate);
     (slots[0] == no_candidate ? slots[0] : slots[1]) = t;
     // An edge with one triangle is a boundary edge of both its vertices.

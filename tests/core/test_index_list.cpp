@@ -60,4 +60,11 @@ TEST(IndexList, EntriesOutsideTheCloudAreRejected) {
   EXPECT_THROW(meshSubset(xyz, past_end), pcl_ms::ReconstructionError);
 }
 
+// An empty list selects no point, which is an error, not the whole cloud.
+TEST(IndexList, AnEmptyListSelectsNoPoint) {
+  const std::vector<float> xyz = twoSpheres();
+  EXPECT_THROW(meshSubset(xyz, std::vector<std::int32_t>()), pcl_ms::ReconstructionError);
+  EXPECT_THROW(meshSubset(xyz, std::vector<std::uint64_t>()), pcl_ms::ReconstructionError);
+}
+
 } // namespace
