@@ -59,7 +59,7 @@ heavy+='|InitialTriangles\.AreKeptAndTheSurfaceIsCompletedAroundThem|PclClass\.B
 heavy+='|App\.BucketsWithProgressAndSummary|Scaffold\.EdgeGraphHoldsOnlyTheCandidatesOfPassOne'
 # Pictures are rendering too: the GL driver's allocations, which LeakSanitizer
 # cannot see into, are reported as leaks.
-pictures='MedialAxisTool\.CompareDrawsItBesideTheSurface'
+pictures='MedialAxisTool\.CompareDrawsItBesideTheSurface|AppSeams\.CompareDrawsSeams'
 # The nodelet's rostest is left out too: ROS's own nodelet manager, which
 # loads the plugin, is not built with ASan, and ASan refuses to start inside
 # it. The same nodelet code runs under ASan in rostest.mesh_node (our node).
