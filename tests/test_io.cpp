@@ -374,6 +374,37 @@ TEST_F(IoLoadPointCloud, AbsurdHeaderCountsFailFast) {
   EXPECT_TRUE(contains(expectCloudFailure(path("huge.ply")), "truncated"));
 }
 
+// PCL's reader goes on parsing header keywords after the DATA line, so data
+// that begins like one would make it read the body with another layout (a
+// fuzzer's finding crashed it). Data that begins like a comment is harmless.
+TEST_F(IoLoadPointCloud, DataThatReadsAsHeaderLineFails) {
+  const std::string header = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                             "WIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\n";
+  std::string body(24, '\0');
+  writeFile(path("columns.pcd"), header + "DATA binary\nCOLUMNS" + body);
+  EXPECT_TRUE(contains(expectCloudFailure(path("columns.pcd")), "COLUMNS header line"));
+  writeFile(path("size.pcd"), header + "DATA ascii\n\n  SIZE 8 8 8\n1 2 3\n4 5 6\n");
+  EXPECT_TRUE(contains(expectCloudFailure(path("size.pcd")), "SIZE header line"));
+  const std::string fuzzer_finding =
+      readFile(kDataDir + "/../tests/fuzz/corpus/pcd/finding_data_reads_as_header.pcd");
+  writeFile(path("finding.pcd"), fuzzer_finding);
+  EXPECT_TRUE(contains(expectCloudFailure(path("finding.pcd")), "header line"));
+
+  // The first x begins with '#' and the data holds a newline: PCL skips that
+  // "comment" line, reads on, and still loads the records from the DATA line.
+  const std::array<float, 6> values = {0.0f, 2.5f, -1.0f, 3.0f, 0.5f, 0.25f};
+  std::string records(sizeof(values), '\0');
+  std::memcpy(records.data(), values.data(), sizeof(values));
+  records[0] = '#';
+  records[5] = '\n';
+  writeFile(path("hash.pcd"), header + "DATA binary\n" + records);
+  pcl::PCLPointCloud2 loaded;
+  std::string error;
+  ASSERT_TRUE(pcl_ms::loadPointCloud(path("hash.pcd"), loaded, error)) << error;
+  ASSERT_EQ(loaded.data.size(), records.size());
+  EXPECT_EQ(std::memcmp(loaded.data.data(), records.data(), records.size()), 0);
+}
+
 TEST_F(IoLoadPointCloud, MissingOrWrongCoordinateFields) {
   writeFile(path("intensity.pcd"), "VERSION 0.7\nFIELDS intensity\nSIZE 4\nTYPE F\nCOUNT 1\n"
                                    "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n1\n2\n");

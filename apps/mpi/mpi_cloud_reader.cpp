@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "mpi_cloud_reader.h"
 
+#include "io_parsing.h"
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -8,135 +10,68 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 namespace pcl_ms_mpi {
-namespace {
 
-// A header longer than this is not one this reader needs to understand.
-constexpr std::size_t max_header_lines = 64, max_header_line = 4096;
-
-bool parseCount(const std::string &word, std::uint64_t &value) {
-  if (word.empty() || word.size() > 19 ||
-      !std::all_of(word.begin(), word.end(), [](char c) { return c >= '0' && c <= '9'; }))
-    return false;
-  value = std::stoull(word);
-  return true;
-}
-
-std::vector<std::string> words(const std::string &line) {
-  std::istringstream stream(line);
-  std::vector<std::string> found;
-  for (std::string word; stream >> word;)
-    found.push_back(word);
-  return found;
-}
-
-bool littleEndianHost() {
-  const std::uint16_t probe = 1;
-  unsigned char first = 0;
-  std::memcpy(&first, &probe, 1);
-  return first == 1;
-}
-
-} // namespace
+using pcl_ms::io_detail::PcdData;
+using pcl_ms::io_detail::PcdField;
+using pcl_ms::io_detail::PcdHeader;
 
 bool describeBinaryPcd(const std::string &path, BinaryCloudLayout &layout, std::string &fields) {
-  if (!littleEndianHost()) // PCD binary data is the writer's memory: little-endian in practice
+  // PCD binary data is the writer's memory: little-endian in practice.
+  if (!pcl_ms::io_detail::hostIsLittleEndian())
     return false;
   std::error_code code;
   const std::uintmax_t size = std::filesystem::file_size(path, code);
   if (code)
     return false;
   std::ifstream in(path, std::ios::binary);
-  std::vector<std::string> names, sizes, types, counts;
-  std::uint64_t width = 0, height = 1, points = 0;
-  bool has_width = false, has_points = false, has_data = false;
-  std::array<float, 3> origin = {0, 0, 0};
-  std::string line;
-  for (std::size_t n = 0; !has_data; ++n) {
-    if (n == max_header_lines || !std::getline(in, line) || line.size() > max_header_line)
-      return false;
-    const std::vector<std::string> w = words(line);
-    if (w.empty() || w[0][0] == '#')
-      continue;
-    const std::vector<std::string> values(w.begin() + 1, w.end());
-    if (w[0] == "VERSION") {
-      continue;
-    } else if (w[0] == "FIELDS") {
-      names = values;
-    } else if (w[0] == "SIZE") {
-      sizes = values;
-    } else if (w[0] == "TYPE") {
-      types = values;
-    } else if (w[0] == "COUNT") {
-      counts = values;
-    } else if (w[0] == "WIDTH" && values.size() == 1) {
-      has_width = parseCount(values[0], width);
-    } else if (w[0] == "HEIGHT" && values.size() == 1) {
-      if (!parseCount(values[0], height))
-        return false;
-    } else if (w[0] == "POINTS" && values.size() == 1) {
-      has_points = parseCount(values[0], points);
-    } else if (w[0] == "VIEWPOINT" && values.size() == 7) {
-      for (int k = 0; k < 3; ++k) {
-        char *end = nullptr;
-        origin[k] = std::strtof(values[k].c_str(), &end);
-        if (*end != '\0' || !std::isfinite(origin[k]))
-          return false;
-      }
-    } else if (w[0] == "DATA" && values.size() == 1 && values[0] == "binary") {
-      has_data = true;
-    } else {
-      return false;
-    }
-  }
-  if (names.empty() || sizes.size() != names.size() || types.size() != names.size() ||
-      (!counts.empty() && counts.size() != names.size()) || !has_width || !has_points ||
-      points == 0 || width > UINT32_MAX || height > UINT32_MAX || width * height != points ||
-      points >= UINT32_MAX)
+  PcdHeader header;
+  std::string ignored;
+  if (!pcl_ms::io_detail::parsePcdHeader(in, header, ignored) || header.data != PcdData::Binary ||
+      header.points >= UINT32_MAX)
     return false;
   BinaryCloudLayout found;
-  std::array<int, 3> xyz = {-1, -1, -1};
-  std::uint64_t offset = 0;
-  for (std::size_t f = 0; f < names.size(); ++f) {
-    std::uint64_t bytes = 0, count = 1;
-    if (!parseCount(sizes[f], bytes) || (bytes != 1 && bytes != 2 && bytes != 4 && bytes != 8) ||
-        (!counts.empty() && (!parseCount(counts[f], count) || count == 0 || count > 1000000)) ||
-        (types[f] != "F" && types[f] != "I" && types[f] != "U"))
+  static const char *const axes[3] = {"x", "y", "z"};
+  static const char *const normals[3] = {"normal_x", "normal_y", "normal_z"};
+  const auto isSingleFloat = [](const PcdField *field) {
+    return field && field->type == 'F' && field->size == 4 && field->count == 1;
+  };
+  for (int k = 0; k < 3; ++k) {
+    const PcdField *axis = header.find(axes[k]);
+    if (!isSingleFloat(axis))
       return false;
-    const bool single_float = types[f] == "F" && bytes == 4 && count == 1;
-    static const char *const axes[3] = {"x", "y", "z"};
-    static const char *const normals[3] = {"normal_x", "normal_y", "normal_z"};
-    for (int k = 0; k < 3; ++k) {
-      if (names[f] == axes[k]) {
-        if (!single_float || xyz[k] >= 0)
-          return false;
-        xyz[k] = static_cast<int>(offset);
-      }
-      if (names[f] == normals[k] && single_float)
-        found.normal[k] = static_cast<std::int32_t>(offset);
-    }
-    offset += bytes * count;
+    found.xyz[k] = static_cast<std::uint32_t>(axis->offset);
+    const PcdField *normal = header.find(normals[k]);
+    if (isSingleFloat(normal))
+      found.normal[k] = static_cast<std::int32_t>(normal->offset);
   }
   // More records than the file could hold: rank 0's guarded loader reports
-  // it, and record offsets below cannot overflow.
-  if (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0 || points > size / offset)
+  // it, and record offsets below cannot overflow. So does a coordinate
+  // named twice.
+  for (const char *axis : axes)
+    if (std::count_if(header.fields.begin(), header.fields.end(),
+                      [&](const PcdField &field) { return field.name == axis; }) != 1)
+      return false;
+  if (header.points > size / header.point_bytes)
     return false;
-  found.data_offset = static_cast<std::uint64_t>(in.tellg());
-  found.points = points;
-  found.record_bytes = offset;
-  found.file_size = size;
-  found.width = static_cast<std::uint32_t>(width);
-  found.height = static_cast<std::uint32_t>(height);
   for (int k = 0; k < 3; ++k)
-    found.xyz[k] = static_cast<std::uint32_t>(xyz[k]);
-  found.xyz_only = names.size() == 3 && offset == 12 && xyz[0] == 0 && xyz[1] == 4 && xyz[2] == 8;
-  found.origin = origin;
+    if (!std::isfinite(header.viewpoint[k]))
+      return false;
+  found.data_offset = header.header_bytes;
+  found.points = header.points;
+  found.record_bytes = header.point_bytes;
+  found.file_size = size;
+  found.width = static_cast<std::uint32_t>(header.width);
+  found.height = static_cast<std::uint32_t>(header.height);
+  found.xyz_only = header.fields.size() == 3 && header.point_bytes == 12 && found.xyz[0] == 0 &&
+                   found.xyz[1] == 4 && found.xyz[2] == 8;
+  for (int k = 0; k < 3; ++k)
+    found.origin[k] = static_cast<float>(header.viewpoint[k]);
   layout = found;
   fields.clear();
-  for (const std::string &name : names)
-    fields += (fields.empty() ? "" : " ") + name;
+  for (const PcdField &field : header.fields)
+    fields += (fields.empty() ? "" : " ") + field.name;
   return true;
 }
 

@@ -138,134 +138,32 @@ bool checkPcdAsciiBody(std::istream &in, std::size_t line_number, std::uint64_t 
 
 bool checkPcdHeader(const std::string &path, std::uintmax_t file_size, std::string &error) {
   std::ifstream in(path, std::ios::binary);
-  std::vector<std::string> fields, sizes, types, counts;
-  bool has_fields = false, has_size = false, has_type = false;
-  std::uint64_t width = 0, height = 1, points = 0;
-  bool has_width = false, has_points = false;
-  std::string data_kind;
-
-  std::string line;
-  std::size_t line_number = 0;
-  while (data_kind.empty()) {
-    if (!readHeaderLine(in, line, kMaxHeaderLine) || ++line_number > kMaxHeaderLines) {
-      error = line_number <= 1 ? "not a PCD file" : "incomplete PCD header (no DATA line)";
-      return false;
-    }
-    const std::string_view text = trim(line);
-    if (text.empty() && !line.empty()) {
-      // PCL's reader skips empty lines but crashes after one of blanks only.
-      error = "PCD header line " + std::to_string(line_number) + " holds only blanks";
-      return false;
-    }
-    if (text.empty() || text.front() == '#')
-      continue;
-    const std::vector<std::string_view> words = splitWords(text);
-    const std::string_view key = words.front();
-    const auto values = [&]() { return std::vector<std::string>(words.begin() + 1, words.end()); };
-    const auto parseCount = [&](std::uint64_t &count) {
-      if (words.size() != 2 || !parseInteger(words[1], count)) {
-        error = "PCD header line " + std::to_string(line_number) + ": bad " + std::string(key) +
-                " value";
-        return false;
-      }
-      return true;
-    };
-    if (key == "VERSION" || key == "VIEWPOINT") {
-      continue;
-    } else if (key == "FIELDS" || key == "COLUMNS") {
-      fields = values();
-      has_fields = true;
-    } else if (key == "SIZE") {
-      sizes = values();
-      has_size = true;
-    } else if (key == "TYPE") {
-      types = values();
-      has_type = true;
-    } else if (key == "COUNT") {
-      counts = values();
-    } else if (key == "WIDTH") {
-      if (!parseCount(width))
-        return false;
-      has_width = true;
-    } else if (key == "HEIGHT") {
-      if (!parseCount(height))
-        return false;
-    } else if (key == "POINTS") {
-      if (!parseCount(points))
-        return false;
-      has_points = true;
-    } else if (key == "DATA") {
-      data_kind = words.size() == 2 ? std::string(words[1]) : std::string("?");
-    } else {
-      error = line_number == 1 ? "not a PCD file"
-                               : "PCD header line " + std::to_string(line_number) +
-                                     ": unknown keyword " + printable(key);
-      return false;
-    }
-  }
-  const std::uint64_t header_bytes = static_cast<std::uint64_t>(in.tellg());
-
-  if (!has_fields || fields.empty() || !has_size || !has_type || !has_width || !has_points) {
-    error = "incomplete PCD header (FIELDS, SIZE, TYPE, WIDTH and POINTS are required)";
+  PcdHeader header;
+  if (!parsePcdHeader(in, header, error))
     return false;
-  }
-  if (sizes.size() != fields.size() || types.size() != fields.size() ||
-      (!counts.empty() && counts.size() != fields.size())) {
-    error = "PCD header: FIELDS, SIZE, TYPE and COUNT list different numbers of entries";
-    return false;
-  }
-  std::uint64_t point_bytes = 0, values_per_point = 0;
-  for (std::size_t f = 0; f < fields.size(); ++f) {
-    unsigned size = 0, count = 1;
-    if (!parseInteger(std::string_view(sizes[f]), size) ||
-        (size != 1 && size != 2 && size != 4 && size != 8)) {
-      error = "PCD header: field '" + fields[f] + "' has an invalid SIZE";
-      return false;
-    }
-    if ((types[f] != "I" && types[f] != "U" && types[f] != "F") ||
-        (types[f] == "F" && size != 4 && size != 8)) {
-      error = "PCD header: field '" + fields[f] + "' has an invalid TYPE";
-      return false;
-    }
-    if (!counts.empty() &&
-        (!parseInteger(std::string_view(counts[f]), count) || count == 0 || count > 1000000)) {
-      error = "PCD header: field '" + fields[f] + "' has an invalid COUNT";
-      return false;
-    }
-    point_bytes += std::uint64_t(size) * count;
-    values_per_point += count;
-  }
-  if (width * height != points) {
-    error = "PCD header: WIDTH x HEIGHT (" + std::to_string(width * height) +
-            ") differs from POINTS (" + std::to_string(points) + ")";
-    return false;
-  }
-  if (points == 0) {
-    error = "the file contains no points";
-    return false;
-  }
+  const std::uint64_t points = header.points;
 
   // Compare what the header promises with what the file holds, in doubles
   // so that absurd counts cannot overflow.
-  const double body = static_cast<double>(file_size) - static_cast<double>(header_bytes);
-  const double expected = static_cast<double>(points) * static_cast<double>(point_bytes);
-  if (data_kind == "ascii") {
+  const double body = static_cast<double>(file_size) - static_cast<double>(header.header_bytes);
+  const double expected = static_cast<double>(points) * static_cast<double>(header.point_bytes);
+  if (header.data == PcdData::Ascii) {
     // Each value needs at least one character and one separator.
-    if (static_cast<double>(points) * static_cast<double>(values_per_point) * 2 - 1 > body) {
+    if (static_cast<double>(points) * static_cast<double>(header.values_per_point) * 2 - 1 > body) {
       error = "truncated PCD file: the header declares " + std::to_string(points) +
               " points but the data is too short";
       return false;
     }
     // PCL silently accepts a short last line, so count the values per line.
-    return checkPcdAsciiBody(in, line_number, points, values_per_point, error);
-  } else if (data_kind == "binary") {
+    return checkPcdAsciiBody(in, header.header_lines, points, header.values_per_point, error);
+  } else if (header.data == PcdData::Binary) {
     if (expected > body) {
       error = "truncated PCD file: " + std::to_string(points) + " points need " +
               std::to_string(static_cast<std::uint64_t>(expected)) + " bytes, the file has " +
               std::to_string(static_cast<std::uint64_t>(std::max(body, 0.0)));
       return false;
     }
-  } else if (data_kind == "binary_compressed") {
+  } else {
     std::uint32_t compressed = 0, uncompressed = 0;
     if (body < 8 || !in.read(reinterpret_cast<char *>(&compressed), 4) ||
         !in.read(reinterpret_cast<char *>(&uncompressed), 4)) {
@@ -280,9 +178,6 @@ bool checkPcdHeader(const std::string &path, std::uintmax_t file_size, std::stri
       error = "truncated PCD file: the compressed block is cut short";
       return false;
     }
-  } else {
-    error = "PCD header: unknown DATA kind " + printable(data_kind);
-    return false;
   }
   return true;
 }

@@ -56,10 +56,6 @@ bool startsWith(std::string_view text, std::string_view prefix) {
   return text.substr(0, prefix.size()) == prefix;
 }
 
-/// Whole-token number parsing, locale independent; accepts a leading '+'.
-/// A float is rounded once from the text, as a writer's binary copy would be.
-
-/// Printable form of a header word for error messages (garbage stays short).
 bool WordLines::next() {
   while (position_ < bytes_.size()) {
     std::size_t end = bytes_.find('\n', position_);
@@ -320,6 +316,194 @@ bool checkPlyBodySize(const PlyHeader &header, std::uintmax_t file_size, std::st
     error = "truncated PLY file: the header declares more data than the file holds";
     return false;
   }
+  return true;
+}
+
+// ---------------------------------------------------------------------------
+// PCD header
+
+namespace {
+
+/// PCL's reader (1.13) does not stop at the DATA line: it goes on reading
+/// lines and applies any that start like a keyword (it compares prefixes)
+/// until one does not. Emulates that on the lines after DATA and fails when
+/// one of them would change the header PCL reads.
+bool dataReadsAsHeader(std::istream &in, std::string &keyword) {
+  static constexpr std::string_view kKeywords[] = {"FIELDS", "COLUMNS", "SIZE",      "TYPE",
+                                                   "COUNT",  "WIDTH",   "HEIGHT",    "POINTS",
+                                                   "DATA",   "VERSION", "VIEWPOINT", "#"};
+  for (;;) {
+    int c = in.get();
+    if (c == std::char_traits<char>::eof())
+      return false;
+    if (c == '\n') // an empty line: PCL skips it
+      continue;
+    while (c != '\n' && c != std::char_traits<char>::eof() && std::isspace(c))
+      c = in.get();
+    std::string word;
+    while (c != '\n' && c != std::char_traits<char>::eof() && !std::isspace(c) &&
+           word.size() < 16) {
+      word.push_back(static_cast<char>(c));
+      c = in.get();
+    }
+    const auto matches = [&](std::string_view key) { return startsWith(word, key); };
+    const auto found = std::find_if(std::begin(kKeywords), std::end(kKeywords), matches);
+    if (found == std::end(kKeywords))
+      return false;
+    if (*found != "#" && *found != "VERSION") { // PCL skips these and reads on
+      keyword = std::string(*found);
+      return true;
+    }
+    if (c != '\n')
+      in.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+  }
+}
+
+} // namespace
+
+bool parsePcdHeader(std::istream &in, PcdHeader &header, std::string &error) {
+  header = PcdHeader();
+  std::vector<std::string> names, sizes, types, counts;
+  bool has_fields = false, has_size = false, has_type = false;
+  bool has_width = false, has_points = false;
+  std::string data_kind;
+
+  std::string line;
+  std::size_t line_number = 0;
+  while (data_kind.empty()) {
+    if (!readHeaderLine(in, line, kMaxHeaderLine) || ++line_number > kMaxHeaderLines) {
+      error = line_number <= 1 ? "not a PCD file" : "incomplete PCD header (no DATA line)";
+      return false;
+    }
+    const std::string_view text = trim(line);
+    if (text.empty() && !line.empty()) {
+      // PCL's reader skips empty lines but crashes after one of blanks only.
+      error = "PCD header line " + std::to_string(line_number) + " holds only blanks";
+      return false;
+    }
+    if (text.empty() || text.front() == '#')
+      continue;
+    const std::vector<std::string_view> words = splitWords(text);
+    const std::string_view key = words.front();
+    const auto values = [&]() { return std::vector<std::string>(words.begin() + 1, words.end()); };
+    const auto badValue = [&]() {
+      error =
+          "PCD header line " + std::to_string(line_number) + ": bad " + std::string(key) + " value";
+      return false;
+    };
+    const auto parseCount = [&](std::uint64_t &count) {
+      return words.size() == 2 && parseInteger(words[1], count);
+    };
+    if (key == "VERSION") {
+      continue;
+    } else if (key == "VIEWPOINT") {
+      if (words.size() != 8)
+        return badValue();
+      for (std::size_t k = 0; k < 7; ++k)
+        if (!parseDouble(words[k + 1], header.viewpoint[k]))
+          return badValue();
+    } else if (key == "FIELDS" || key == "COLUMNS") {
+      names = values();
+      has_fields = true;
+    } else if (key == "SIZE") {
+      sizes = values();
+      has_size = true;
+    } else if (key == "TYPE") {
+      types = values();
+      has_type = true;
+    } else if (key == "COUNT") {
+      counts = values();
+    } else if (key == "WIDTH") {
+      if (!parseCount(header.width))
+        return badValue();
+      has_width = true;
+    } else if (key == "HEIGHT") {
+      if (!parseCount(header.height))
+        return badValue();
+    } else if (key == "POINTS") {
+      if (!parseCount(header.points))
+        return badValue();
+      has_points = true;
+    } else if (key == "DATA") {
+      data_kind = words.size() == 2 ? std::string(words[1]) : std::string("?");
+    } else {
+      error = line_number == 1 ? "not a PCD file"
+                               : "PCD header line " + std::to_string(line_number) +
+                                     ": unknown keyword " + printable(key);
+      return false;
+    }
+  }
+  const std::streampos data_begins = in.tellg();
+  if (data_begins < 0) { // the DATA line ends the file
+    error = "truncated PCD file: nothing follows the header";
+    return false;
+  }
+  header.header_bytes = static_cast<std::uint64_t>(data_begins);
+  header.header_lines = line_number;
+
+  if (data_kind == "ascii") {
+    header.data = PcdData::Ascii;
+  } else if (data_kind == "binary") {
+    header.data = PcdData::Binary;
+  } else if (data_kind == "binary_compressed") {
+    header.data = PcdData::BinaryCompressed;
+  } else {
+    error = "PCD header: unknown DATA kind " + printable(data_kind);
+    return false;
+  }
+  if (!has_fields || names.empty() || !has_size || !has_type || !has_width || !has_points) {
+    error = "incomplete PCD header (FIELDS, SIZE, TYPE, WIDTH and POINTS are required)";
+    return false;
+  }
+  if (sizes.size() != names.size() || types.size() != names.size() ||
+      (!counts.empty() && counts.size() != names.size())) {
+    error = "PCD header: FIELDS, SIZE, TYPE and COUNT list different numbers of entries";
+    return false;
+  }
+  for (std::size_t f = 0; f < names.size(); ++f) {
+    PcdField field;
+    field.name = names[f];
+    if (!parseInteger(std::string_view(sizes[f]), field.size) ||
+        (field.size != 1 && field.size != 2 && field.size != 4 && field.size != 8)) {
+      error = "PCD header: field '" + field.name + "' has an invalid SIZE";
+      return false;
+    }
+    field.type = types[f].size() == 1 ? types[f][0] : '?';
+    if ((field.type != 'I' && field.type != 'U' && field.type != 'F') ||
+        (field.type == 'F' && field.size != 4 && field.size != 8)) {
+      error = "PCD header: field '" + field.name + "' has an invalid TYPE";
+      return false;
+    }
+    if (!counts.empty() && (!parseInteger(std::string_view(counts[f]), field.count) ||
+                            field.count == 0 || field.count > 1000000)) {
+      error = "PCD header: field '" + field.name + "' has an invalid COUNT";
+      return false;
+    }
+    field.offset = header.point_bytes;
+    header.point_bytes += std::uint64_t(field.size) * field.count;
+    header.values_per_point += field.count;
+    header.fields.push_back(field);
+  }
+  // WIDTH and HEIGHT are 32-bit in PCL; their product must not wrap either.
+  if (header.width > UINT32_MAX || header.height > UINT32_MAX ||
+      header.width * header.height != header.points) {
+    error = "PCD header: WIDTH x HEIGHT (" + std::to_string(header.width) + " x " +
+            std::to_string(header.height) + ") differs from POINTS (" +
+            std::to_string(header.points) + ")";
+    return false;
+  }
+  if (header.points == 0) {
+    error = "the file contains no points";
+    return false;
+  }
+  std::string keyword;
+  if (dataReadsAsHeader(in, keyword)) {
+    error =
+        "corrupt PCD file: the data after the DATA line begins like a " + keyword + " header line";
+    return false;
+  }
+  in.clear();
+  in.seekg(static_cast<std::streamoff>(header.header_bytes));
   return true;
 }
 

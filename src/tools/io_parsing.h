@@ -4,6 +4,7 @@
 // Internal to the library: not installed.
 #pragma once
 
+#include <array>
 #include <charconv>
 #include <cstddef>
 #include <cstdint>
@@ -121,6 +122,44 @@ bool parsePlyHeader(std::istream &in, PlyHeader &header, std::string &error);
 /// Rejects files shorter than the smallest body their header allows, which
 /// catches truncation and absurd element counts before anything is allocated.
 bool checkPlyBodySize(const PlyHeader &header, std::uintmax_t file_size, std::string &error);
+
+// ---------------------------------------------------------------------------
+// PCD header (checked before PCL's reader sees a file; read by the MPI tool)
+
+enum class PcdData { Ascii, Binary, BinaryCompressed };
+
+struct PcdField {
+  std::string name;
+  unsigned size = 4;        // bytes of one value: 1, 2, 4 or 8
+  char type = 'F';          // 'F', 'I' or 'U'
+  unsigned count = 1;       // values per point
+  std::uint64_t offset = 0; // byte offset in a binary record
+};
+
+struct PcdHeader {
+  std::vector<PcdField> fields;
+  std::uint64_t width = 0, height = 1, points = 0;
+  std::array<double, 7> viewpoint = {0, 0, 0, 1, 0, 0, 0}; // tx ty tz qw qx qy qz
+  PcdData data = PcdData::Ascii;
+  std::uint64_t header_bytes = 0; // where the data begins
+  std::size_t header_lines = 0;
+  std::uint64_t point_bytes = 0;      // one binary record
+  std::uint64_t values_per_point = 0; // one ASCII line
+
+  const PcdField *find(std::string_view name) const {
+    for (const PcdField &field : fields)
+      if (field.name == name)
+        return &field;
+    return nullptr;
+  }
+};
+
+/// Reads and checks a PCD header: known keywords only, consistent field
+/// lists, WIDTH x HEIGHT = POINTS > 0. Also rejects a file whose data begins
+/// with a line PCL's reader would take for one more header line (it keeps
+/// parsing keywords after DATA), since PCL then reads the body with a layout
+/// the file does not have. Leaves `in` at the first byte of the data.
+bool parsePcdHeader(std::istream &in, PcdHeader &header, std::string &error);
 
 } // namespace io_detail
 } // namespace pcl_ms
