@@ -10,33 +10,86 @@
 namespace pcl_ms {
 namespace detail {
 
-EdgeUses edgeUses(const std::vector<Triangle> &triangles) {
+namespace {
+
+/// One (edge, triangle) incidence, filed under the edge's lower vertex.
+struct EdgeUse {
+  VertexIndex high; // the edge's other vertex
+  std::uint32_t triangle;
+  bool operator<(const EdgeUse &other) const {
+    return high < other.high || (high == other.high && triangle < other.triangle);
+  }
+};
+
+/// Calls visit(key, first, count) for each distinct edge in key order, with
+/// its `count` incidences at [first, first + count), sorted by triangle. A
+/// 20M-triangle surface has 60M incidences: holding them all beside the
+/// triangles, points and pairs set the peak of a whole MPI run's rank 0
+/// (docs/algorithm.md, "Across processes"), so they are sorted in blocks.
+template <typename Visit>
+void forEachEdge(const std::vector<Triangle> &triangles, std::size_t block_uses, Visit &&visit) {
   VertexIndex vertex_count = 0;
   for (const Triangle &triangle : triangles)
     for (VertexIndex v : triangle)
       vertex_count = std::max(vertex_count, v + 1);
-  EdgeUses result;
-  std::vector<std::uint32_t> &offsets = result.offsets;
-  offsets.assign(static_cast<std::size_t>(vertex_count) + 1, 0);
+  // offsets[v]: the incidences filed under vertices below v.
+  std::vector<std::uint64_t> offsets(static_cast<std::size_t>(vertex_count) + 1, 0);
   for (const Triangle &triangle : triangles)
     for (int k = 0; k < 3; ++k)
       ++offsets[lowVertex(edgeKey(triangle[k], triangle[(k + 1) % 3])) + 1];
   for (std::size_t v = 0; v < vertex_count; ++v)
     offsets[v + 1] += offsets[v];
-  result.uses.resize(3 * triangles.size());
-  std::vector<std::uint32_t> cursor(offsets.begin(), offsets.end() - 1);
-  for (std::uint32_t t = 0; t < triangles.size(); ++t)
-    for (int k = 0; k < 3; ++k) {
-      const EdgeKey key = edgeKey(triangles[t][k], triangles[t][(k + 1) % 3]);
-      result.uses[cursor[lowVertex(key)]++] = {highVertex(key), t};
+  std::vector<EdgeUse> uses;
+  std::vector<std::uint32_t> cursor;
+  for (VertexIndex begin = 0; begin < vertex_count;) {
+    VertexIndex end = begin + 1;
+    while (end < vertex_count && offsets[end + 1] - offsets[begin] <= block_uses)
+      ++end;
+    const std::uint64_t base = offsets[begin];
+    uses.resize(offsets[end] - base);
+    cursor.resize(end - begin);
+    for (VertexIndex v = begin; v < end; ++v)
+      cursor[v - begin] = static_cast<std::uint32_t>(offsets[v] - base);
+    for (std::uint32_t t = 0; t < triangles.size(); ++t)
+      for (int k = 0; k < 3; ++k) {
+        const EdgeKey key = edgeKey(triangles[t][k], triangles[t][(k + 1) % 3]);
+        const VertexIndex low = lowVertex(key);
+        if (low >= begin && low < end)
+          uses[cursor[low - begin]++] = {highVertex(key), t};
+      }
+    forEachIndex(end - begin, [&](std::size_t i) {
+      std::sort(uses.begin() + static_cast<std::ptrdiff_t>(offsets[begin + i] - base),
+                uses.begin() + static_cast<std::ptrdiff_t>(offsets[begin + i + 1] - base));
+    });
+    for (VertexIndex low = begin; low < end; ++low) {
+      const std::size_t last = offsets[low + 1] - base;
+      for (std::size_t i = offsets[low] - base; i < last;) {
+        std::size_t j = i;
+        while (j < last && uses[j].high == uses[i].high)
+          ++j;
+        visit(edgeKey(low, uses[i].high), &uses[i], j - i);
+        i = j;
+      }
     }
-  forEachIndex(vertex_count, [&](std::size_t v) {
-    std::sort(result.uses.begin() + offsets[v], result.uses.begin() + offsets[v + 1]);
-  });
-  return result;
+    begin = end;
+  }
 }
 
-std::vector<std::vector<VertexIndex>> boundaryLoops(const EdgeUses &uses) {
+} // namespace
+
+MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_pairs,
+                    std::size_t block_uses) {
+  MeshEdges edges;
+  forEachEdge(triangles, block_uses, [&](EdgeKey key, const EdgeUse *first, std::size_t count) {
+    if (count == 1)
+      edges.boundary.push_back(key);
+    else if (count == 2 && with_pairs)
+      edges.pairs.push_back({first[0].triangle, first[1].triangle});
+  });
+  return edges;
+}
+
+std::vector<std::vector<VertexIndex>> boundaryLoops(const std::vector<EdgeKey> &boundary) {
   // Boundary edges in both directions, sorted: a CSR of boundary neighbours.
   struct HalfEdge {
     VertexIndex from, to;
@@ -46,16 +99,13 @@ std::vector<std::vector<VertexIndex>> boundaryLoops(const EdgeUses &uses) {
     }
   };
   std::vector<HalfEdge> half_edges;
-  std::uint32_t boundary_edges = 0;
-  forEachEdge(uses, [&](EdgeKey key, std::size_t, std::size_t count) {
-    if (count != 1)
-      return;
-    half_edges.push_back({lowVertex(key), highVertex(key), boundary_edges});
-    half_edges.push_back({highVertex(key), lowVertex(key), boundary_edges});
-    ++boundary_edges;
-  });
+  half_edges.reserve(2 * boundary.size());
+  for (std::uint32_t e = 0; e < boundary.size(); ++e) {
+    half_edges.push_back({lowVertex(boundary[e]), highVertex(boundary[e]), e});
+    half_edges.push_back({highVertex(boundary[e]), lowVertex(boundary[e]), e});
+  }
   std::sort(half_edges.begin(), half_edges.end());
-  std::vector<bool> used(boundary_edges, false);
+  std::vector<bool> used(boundary.size(), false);
   auto nextFrom = [&](VertexIndex v) -> const HalfEdge * {
     HalfEdge probe{v, 0, 0};
     for (auto it = std::lower_bound(half_edges.begin(), half_edges.end(), probe);
@@ -86,19 +136,6 @@ std::vector<std::vector<VertexIndex>> boundaryLoops(const EdgeUses &uses) {
   return loops;
 }
 
-std::vector<ManifoldPair> manifoldPairs(const EdgeUses &uses) {
-  std::size_t count_of_pairs = 0;
-  forEachEdge(uses, [&](EdgeKey, std::size_t, std::size_t count) { count_of_pairs += count == 2; });
-  std::vector<ManifoldPair> pairs;
-  pairs.reserve(count_of_pairs);
-  forEachEdge(uses, [&](EdgeKey key, std::size_t first, std::size_t count) {
-    if (count == 2)
-      pairs.push_back({uses.uses[first].triangle, uses.uses[first + 1].triangle, lowVertex(key),
-                       highVertex(key)});
-  });
-  return pairs;
-}
-
 } // namespace detail
 
 namespace {
@@ -111,7 +148,7 @@ constexpr int max_untwist_loop_edges = 16;
 } // namespace
 
 std::vector<std::vector<VertexIndex>> traceBoundaryLoops(const std::vector<Triangle> &triangles) {
-  return detail::boundaryLoops(detail::edgeUses(triangles));
+  return detail::boundaryLoops(detail::meshEdges(triangles, false).boundary);
 }
 
 FinishedSurface finishSurface(std::vector<Triangle> triangles,
@@ -119,22 +156,19 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
                               const SideLimit &limit, const std::vector<bool> *anchored_vertices,
                               const Eigen::Vector3d *viewpoint) {
   FinishedSurface surface;
-  // Edge uses are built once per set of triangles. Orienting keeps the set,
-  // so the boundary loops are traced before it and the uses freed: the
-  // orientation's own arrays are as large.
+  // The edges are scanned once per set of triangles.
   auto fillThenOrient = [&](int max_edges, const std::vector<bool> *only_around) {
-    detail::EdgeUses uses = detail::edgeUses(triangles);
-    surface.boundary_loops = detail::boundaryLoops(uses);
+    detail::MeshEdges edges = detail::meshEdges(triangles, true);
+    surface.boundary_loops = detail::boundaryLoops(edges.boundary);
     const std::size_t filled =
         detail::fillLoops(triangles, surface.boundary_loops, points, max_edges, limit, only_around);
     if (filled > 0) {
-      uses = detail::edgeUses(triangles);
-      surface.boundary_loops = detail::boundaryLoops(uses);
+      edges = detail::MeshEdges(); // freed before the new scan
+      edges = detail::meshEdges(triangles, true);
+      surface.boundary_loops = detail::boundaryLoops(edges.boundary);
     }
     surface.holes_filled += filled;
-    const std::vector<detail::ManifoldPair> pairs = detail::manifoldPairs(uses);
-    uses = detail::EdgeUses();
-    return detail::orientPairs(triangles, pairs, points, surface.triangle_component,
+    return detail::orientPairs(triangles, edges.pairs, points, surface.triangle_component,
                                surface.component_orientable, viewpoint);
   };
   std::vector<std::uint32_t> to_cut = fillThenOrient(fill_holes_max_edges, nullptr);

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Stage 4's steps and the mesh structure they share (docs/algorithm.md
-// section 4). In: a triangle list. Out: edge uses, boundary loops, manifold
+// section 4). In: a triangle list. Out: boundary edges and loops, manifold
 // pairs (finish.cpp), filled holes (hole_filling.cpp), orientation and cuts
 // (orientation.cpp), dropped triangles (bow_ties.cpp). Internal: not installed.
 #pragma once
@@ -20,23 +20,6 @@
 namespace pcl_ms {
 namespace detail {
 
-/// One (edge, triangle) incidence, filed under the edge's lower vertex.
-struct EdgeUse {
-  VertexIndex high; // the edge's other vertex
-  std::uint32_t triangle;
-  bool operator<(const EdgeUse &other) const {
-    return high < other.high || (high == other.high && triangle < other.triangle);
-  }
-};
-
-/// Every (edge, triangle) incidence, by lower vertex (CSR), then by upper
-/// vertex and triangle: 8 bytes an incidence, and only each vertex's few
-/// edges are sorted.
-struct EdgeUses {
-  std::vector<std::uint32_t> offsets; // vertex v's uses are [offsets[v], offsets[v + 1])
-  std::vector<EdgeUse> uses;
-};
-
 /// Calls work(i) for every i in [0, count), in parallel within the caller's
 /// task arena. Each call must touch only its own outputs, so the result does
 /// not depend on the number of threads.
@@ -49,36 +32,29 @@ template <typename Work> void forEachIndex(std::size_t count, const Work &work) 
                     });
 }
 
-EdgeUses edgeUses(const std::vector<Triangle> &triangles);
-
-/// Calls visit(key, first_use, count) for each distinct edge, in key order;
-/// first_use indexes uses.uses.
-template <typename Visit> void forEachEdge(const EdgeUses &uses, const Visit &visit) {
-  const std::size_t vertex_count = uses.offsets.empty() ? 0 : uses.offsets.size() - 1;
-  for (std::size_t low = 0; low < vertex_count; ++low) {
-    const std::size_t end = uses.offsets[low + 1];
-    for (std::size_t i = uses.offsets[low]; i < end;) {
-      std::size_t j = i;
-      while (j < end && uses.uses[j].high == uses.uses[i].high)
-        ++j;
-      visit(edgeKey(static_cast<VertexIndex>(low), uses.uses[i].high), i, j - i);
-      i = j;
-    }
-  }
-}
-
-/// Two triangles sharing a manifold edge and the edge's end points (how much
-/// the surface bends there is bendingAt(), computed where orientation needs it).
+/// Two triangles sharing a manifold edge, first < second (the edge and how
+/// much the surface bends there are computed where orientation needs them:
+/// 8 bytes a pair keep the finishing of a whole 10M-point surface lean).
 struct ManifoldPair {
   std::uint32_t first, second;
-  VertexIndex a, b; // the shared edge
 };
 
-std::vector<ManifoldPair> manifoldPairs(const EdgeUses &uses);
+/// What one scan of a triangle list's edges finds, both in edge-key order.
+struct MeshEdges {
+  std::vector<EdgeKey> boundary;   // edges with one triangle
+  std::vector<ManifoldPair> pairs; // edges with two (only when asked for)
+};
 
-/// Cyclic boundary loops (edges with one triangle), each starting at its
-/// smallest vertex, in order of that vertex.
-std::vector<std::vector<VertexIndex>> boundaryLoops(const EdgeUses &uses);
+/// Scans every edge of `triangles` once. The (edge, triangle) incidences are
+/// sorted a block of lower vertices at a time, at most `block_uses` per
+/// block (16M: 128 MB), so that finishing a 20M-triangle surface never holds
+/// them all. The result does not depend on the block size.
+MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_pairs,
+                    std::size_t block_uses = std::size_t(1) << 24);
+
+/// Cyclic boundary loops traced along boundary edges (sorted), each starting
+/// at its smallest vertex, in order of that vertex.
+std::vector<std::vector<VertexIndex>> boundaryLoops(const std::vector<EdgeKey> &boundary);
 
 /// Closes loops of at most max_edges edges with triangles of the Delaunay
 /// triangulation of the loop's vertices (minimum total P / C^2, no edge

@@ -168,6 +168,7 @@ std::size_t fillLoops(std::vector<Triangle> &triangles, std::vector<std::vector<
     }
 
   std::size_t filled = 0;
+  std::vector<Triangle> added;
   for (const auto &loop : loops) {
     if (loop.size() < 3 || loop.size() > static_cast<std::size_t>(max_edges))
       continue;
@@ -190,9 +191,13 @@ std::size_t fillLoops(std::vector<Triangle> &triangles, std::vector<std::vector<
         const EdgeKey key = edgeKey(t[k], t[(k + 1) % 3]);
         mesh_edges.insert(std::lower_bound(mesh_edges.begin(), mesh_edges.end(), key), key);
       }
-    triangles.insert(triangles.end(), filling.begin(), filling.end());
+    added.insert(added.end(), filling.begin(), filling.end());
     ++filled;
   }
+  // Exactly the room needed: growing a 20M-triangle list by doubling would
+  // keep 240 MB unused through the rest of the finishing.
+  triangles.reserve(triangles.size() + added.size());
+  triangles.insert(triangles.end(), added.begin(), added.end());
   return filled;
 }
 

@@ -96,15 +96,56 @@ constexpr double kruskal_flat_bending = 0.5;
 
 double bendingAt(const ManifoldPair &pair, const std::vector<Triangle> &triangles,
                  const std::vector<Eigen::Vector3d> &points) {
-  auto apex = [&](std::uint32_t t) {
-    for (VertexIndex v : triangles[t])
-      if (v != pair.a && v != pair.b)
-        return v;
-    return pair.a;
-  };
-  return bendingAngle(points[pair.a], points[pair.b], points[apex(pair.first)],
-                      points[apex(pair.second)]);
+  const Triangle &first = triangles[pair.first], &second = triangles[pair.second];
+  auto inSecond = [&](VertexIndex v) { return v == second[0] || v == second[1] || v == second[2]; };
+  // The shared edge, lower vertex first, and each triangle's third vertex.
+  VertexIndex shared[2] = {0, 0}, first_apex = first[0];
+  int found = 0;
+  for (VertexIndex v : first)
+    if (inSecond(v) && found < 2)
+      shared[found++] = v;
+    else
+      first_apex = v;
+  const VertexIndex a = std::min(shared[0], shared[1]), b = std::max(shared[0], shared[1]);
+  VertexIndex second_apex = second[0];
+  for (VertexIndex v : second)
+    if (v != a && v != b)
+      second_apex = v;
+  return bendingAngle(points[a], points[b], points[first_apex], points[second_apex]);
 }
+
+/// The manifold pairs of each triangle, in pair order: at most three, one
+/// per edge, so three slots a triangle and no offsets (12 bytes a triangle).
+class PairsOfTriangles {
+public:
+  static constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
+
+  PairsOfTriangles(const std::vector<ManifoldPair> &pairs, std::size_t triangle_count)
+      : slots_(3 * triangle_count, none) {
+    for (std::uint32_t p = 0; p < pairs.size(); ++p)
+      for (std::uint32_t t : {pairs[p].first, pairs[p].second})
+        for (std::size_t k = 3 * std::size_t{t};; ++k)
+          if (slots_[k] == none) { // a triangle has at most 3 edges, so a free slot
+            slots_[k] = p;
+            break;
+          }
+  }
+
+  /// Triangle t's pairs.
+  struct Range {
+    const std::uint32_t *begin_, *end_;
+    const std::uint32_t *begin() const { return begin_; }
+    const std::uint32_t *end() const { return end_; }
+    std::size_t size() const { return static_cast<std::size_t>(end_ - begin_); }
+  };
+  Range of(std::uint32_t t) const {
+    const std::uint32_t *first = &slots_[3 * std::size_t{t}];
+    return {first, std::find(first, first + 3, none)};
+  }
+
+private:
+  std::vector<std::uint32_t> slots_;
+};
 
 /// Whether t and u run their shared edge in opposite directions.
 bool consistentlyOriented(const Triangle &t, const Triangle &u) {
@@ -120,9 +161,8 @@ bool consistentlyOriented(const Triangle &t, const Triangle &u) {
 /// reversed) states. `reached` has one entry per triangle, all 0 (bit 0:
 /// reached as it is, bit 1: reversed), and is left so.
 bool reversesWithin(std::uint32_t start, int max_steps, const std::vector<ManifoldPair> &pairs,
-                    const std::vector<std::uint32_t> &offsets,
-                    const std::vector<std::uint32_t> &incident,
-                    const std::vector<std::uint8_t> &flips, std::vector<std::uint8_t> &reached) {
+                    const PairsOfTriangles &incident, const std::vector<std::uint8_t> &flips,
+                    std::vector<std::uint8_t> &reached) {
   using State = std::pair<std::uint32_t, bool>;
   std::vector<State> frontier = {{start, false}}, next;
   std::vector<std::uint32_t> touched = {start};
@@ -131,10 +171,11 @@ bool reversesWithin(std::uint32_t start, int max_steps, const std::vector<Manifo
   for (int step = 0; step < max_steps && !frontier.empty() && !reverses; ++step) {
     next.clear();
     for (const auto &[t, reversed] : frontier)
-      for (std::uint32_t i = offsets[t]; i < offsets[t + 1] && !reverses; ++i) {
-        const ManifoldPair &pair = pairs[incident[i]];
-        const State state{pair.first == t ? pair.second : pair.first,
-                          reversed != (flips[incident[i]] != 0)};
+      for (std::uint32_t p : incident.of(t)) {
+        if (reverses)
+          break;
+        const ManifoldPair &pair = pairs[p];
+        const State state{pair.first == t ? pair.second : pair.first, reversed != (flips[p] != 0)};
         reverses = state.first == start && state.second;
         const std::uint8_t bit = state.second ? 2 : 1;
         if (reached[state.first] & bit)
@@ -160,21 +201,7 @@ std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
                                        std::vector<bool> &component_orientable,
                                        const Eigen::Vector3d *viewpoint) {
   const std::uint32_t unvisited = std::numeric_limits<std::uint32_t>::max();
-  std::vector<std::uint32_t> offsets(triangles.size() + 1, 0);
-  for (const ManifoldPair &pair : pairs) {
-    ++offsets[pair.first + 1];
-    ++offsets[pair.second + 1];
-  }
-  for (std::size_t t = 0; t < triangles.size(); ++t)
-    offsets[t + 1] += offsets[t];
-  std::vector<std::uint32_t> incident(offsets.back());
-  {
-    std::vector<std::uint32_t> cursor(offsets.begin(), offsets.end() - 1);
-    for (std::uint32_t p = 0; p < pairs.size(); ++p) {
-      incident[cursor[pairs[p].first]++] = p;
-      incident[cursor[pairs[p].second]++] = p;
-    }
-  }
+  const PairsOfTriangles incident(pairs, triangles.size());
   // Sets the orientation of `next` from its already oriented neighbour.
   auto orientAcross = [&](const ManifoldPair &pair, std::uint32_t component) {
     const bool first_known = triangle_component[pair.first] == component;
@@ -201,8 +228,8 @@ std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
     std::vector<std::uint32_t> &queue = members.back();
     for (std::size_t head = 0; head < queue.size(); ++head) {
       const std::uint32_t t = queue[head];
-      for (std::uint32_t i = offsets[t]; i < offsets[t + 1]; ++i) {
-        const ManifoldPair &pair = pairs[incident[i]];
+      for (std::uint32_t p : incident.of(t)) {
+        const ManifoldPair &pair = pairs[p];
         if (triangle_component[pair.first] == unvisited ||
             triangle_component[pair.second] == unvisited)
           queue.push_back(orientAcross(pair, component));
@@ -303,12 +330,12 @@ std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
       const int long_walk = static_cast<int>(
           max_twist_steps_per_root * std::sqrt(static_cast<double>(members[component].size())));
       auto localTwist = [&]() {
-        if (reversesWithin(pairs[p].first, max_local_twist_steps, pairs, offsets, incident,
-                           conflict, reached))
+        if (reversesWithin(pairs[p].first, max_local_twist_steps, pairs, incident, conflict,
+                           reached))
           return true;
         if (holds_real_twist[component] || long_walk <= max_local_twist_steps)
           return false;
-        if (reversesWithin(pairs[p].first, long_walk, pairs, offsets, incident, conflict, reached))
+        if (reversesWithin(pairs[p].first, long_walk, pairs, incident, conflict, reached))
           return true;
         holds_real_twist[component] = true;
         return false;
@@ -334,7 +361,7 @@ std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
       signed_volume += a.dot(b.cross(c));
       if (viewpoint)
         facing += (b - a).cross(c - a).dot(*viewpoint - a);
-      closed = closed && offsets[t + 1] - offsets[t] == 3;
+      closed = closed && incident.of(t).size() == 3;
     }
     if ((viewpoint && !closed ? facing : signed_volume) < 0)
       for (std::uint32_t t : members[component])
@@ -350,7 +377,7 @@ std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
                                             std::vector<std::uint32_t> &triangle_component,
                                             std::vector<bool> &component_orientable,
                                             const Eigen::Vector3d *viewpoint) {
-  return detail::orientPairs(triangles, detail::manifoldPairs(detail::edgeUses(triangles)), points,
+  return detail::orientPairs(triangles, detail::meshEdges(triangles, true).pairs, points,
                              triangle_component, component_orientable, viewpoint);
 }
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Unit tests of each core stage on configurations whose answers are known by hand.
 #include "core_test_support.h"
+#include "finish_steps.h"
 
 #include <pcl_ms/costs.h>
 #include <pcl_ms/finish.h>
@@ -374,6 +375,29 @@ TEST(Finish, BoundaryLoopOfTwoTriangles) {
   const auto loops = traceBoundaryLoops(square);
   ASSERT_EQ(loops.size(), 1u);
   EXPECT_EQ(loops[0], (std::vector<VertexIndex>{0, 1, 2, 3}));
+}
+
+// The edge scan sorts incidences a block of vertices at a time; any block
+// size must find the same edges in the same order (the bunny's reference
+// mesh: open at the base, so both kinds).
+TEST(Finish, EdgeScanDoesNotDependOnTheBlockSize) {
+  const std::vector<Triangle> &triangles = pcl_ms_test::bunnyReference().triangles;
+  const detail::MeshEdges whole = detail::meshEdges(triangles, true);
+  ASSERT_FALSE(whole.boundary.empty());
+  EXPECT_EQ(2 * whole.pairs.size() + whole.boundary.size(), 3 * triangles.size());
+  EXPECT_TRUE(std::is_sorted(whole.boundary.begin(), whole.boundary.end()));
+  for (std::size_t block :
+       {std::size_t(1), std::size_t(5), std::size_t(1000), std::size_t(77777)}) {
+    SCOPED_TRACE(block);
+    const detail::MeshEdges blocks = detail::meshEdges(triangles, true, block);
+    EXPECT_EQ(blocks.boundary, whole.boundary);
+    ASSERT_EQ(blocks.pairs.size(), whole.pairs.size());
+    for (std::size_t p = 0; p < whole.pairs.size(); ++p)
+      ASSERT_TRUE(blocks.pairs[p].first == whole.pairs[p].first &&
+                  blocks.pairs[p].second == whole.pairs[p].second)
+          << "pair " << p;
+  }
+  EXPECT_EQ(traceBoundaryLoops(triangles), detail::boundaryLoops(whole.boundary));
 }
 
 TEST(Finish, FillsTheMissingFaceOfACube) {
