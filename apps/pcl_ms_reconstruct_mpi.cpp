@@ -179,12 +179,26 @@ SliceStatus readCloudInParts(const Job &job, const std::string &path,
   return all;
 }
 
+/// Hands the heap's free pages back to the system. Rank 0 meshes units on a
+/// thread of its own, whose small allocations leave free pages scattered
+/// through its heap; returned after each stage, they no longer count in the
+/// finishing stage's peak (docs/algorithm.md, "Across processes").
+void returnFreeMemory() {
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
+}
+
 /// Rank 0: meshes `points`, with the other ranks meshing the units it
-/// hands out, and frees them.
+/// hands out, and frees them as soon as the core has prepared its copy.
 template <typename PointT>
 pcl_ms::Result meshPoints(const Job &job, pcl::PointCloud<PointT> &&points,
                           const pcl_ms::Parameters &parameters, pcl_ms_mpi::MpiUnitFarm &exchange) {
-  const pcl::PointCloud<PointT> owned = std::move(points);
+  pcl::PointCloud<PointT> owned = std::move(points);
+  exchange.onPointsPrepared([&owned] {
+    pcl::PointCloud<PointT>().swap(owned);
+    returnFreeMemory();
+  });
   // As pcl::MedialScaffoldReconstruction passes them: no indices, normals
   // from the point type.
   pcl_ms::PointView view;
@@ -198,7 +212,9 @@ pcl_ms::Result meshPoints(const Job &job, pcl::PointCloud<PointT> &&points,
     }
   }
   try {
-    return pcl_ms::reconstruct(view, parameters, exchange);
+    pcl_ms::Result result = pcl_ms::reconstruct(view, parameters, exchange);
+    exchange.onPointsPrepared({});
+    return result;
   } catch (const std::exception &error) {
     abortJob(job, kReconstructionFailure, std::string("reconstruction failed: ") + error.what());
   }
@@ -283,6 +299,7 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   pcl_ms_mpi::MpiUnitFarm exchange(job.communicator, parameters, [&](const std::string &stage) {
+    returnFreeMemory();
     if (verbose)
       std::fprintf(stderr, "  all ranks: %s done, %.1f s elapsed\n", stage.c_str(),
                    secondsSinceStart());

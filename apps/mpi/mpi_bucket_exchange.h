@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pcl_ms_mpi {
@@ -29,6 +30,14 @@ public:
 
   pcl_ms::UnitFarm *farm() override { return size_ > 1 ? this : nullptr; }
   void stageDone(const std::string &stage) override;
+  void pointsPrepared() override {
+    if (on_prepared_)
+      on_prepared_();
+  }
+  /// Runs once the points are prepared (the caller's cloud may go then).
+  void onPointsPrepared(std::function<void()> on_prepared) {
+    on_prepared_ = std::move(on_prepared);
+  }
   void mesh(std::size_t count, const std::function<pcl_ms::BucketTask(std::size_t)> &make,
             const std::function<void(std::size_t, pcl_ms::BucketOutcome &&)> &done) override;
   /// Tells every other rank that no more units come; call once, at the end.
@@ -43,6 +52,7 @@ private:
   pcl_ms::Deadline deadline_;
   int size_ = 1;
   std::function<void(const std::string &)> on_stage_;
+  std::function<void()> on_prepared_;
   std::size_t bytes_sent_ = 0, bytes_received_ = 0;
   bool released_ = false;
 };

@@ -256,41 +256,64 @@ std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
                                      false) != component_orientable.end();
   std::vector<std::uint32_t> to_cut;
   if (any_twisted) {
-    std::vector<double> bending(pairs.size(), 0.0); // in twisted components only
-    forEachIndex(pairs.size(), [&](std::size_t p) {
-      if (inTwistedComponent(p))
-        bending[p] = bendingAt(pairs[p], triangles, points);
-    });
     // Kruskal's forest after the flat pairs does not depend on their order
     // when no cycle of flat pairs is twisted: the same triangles end up
-    // together with the same relative flips. So they are joined unsorted,
-    // and only the few bent pairs are sorted. A twist among flat pairs
-    // needs Kruskal's order throughout.
-    std::vector<std::uint32_t> flat_pairs, bent_pairs;
-    for (std::uint32_t p = 0; p < pairs.size(); ++p)
-      if (inTwistedComponent(p))
-        (bending[p] < kruskal_flat_bending ? flat_pairs : bent_pairs).push_back(p);
+    // together with the same relative flips. So they are joined unsorted, as
+    // met, and only the few bent pairs are kept and sorted; the bending is
+    // computed a block of pairs at a time, never stored for them all (at 10M
+    // points that was 240 MB). A twist among flat pairs needs Kruskal's
+    // order throughout.
     ParityForest forest(triangles.size());
     // Flipping exactly one of a pair changes whether the two agree.
     auto join = [&](std::uint32_t p) {
       return forest.join(pairs[p].first, pairs[p].second, inconsistent[p]);
     };
+    struct BentPair {
+      double bending;
+      std::uint32_t pair;
+    };
+    std::vector<BentPair> bent_pairs;
+    // Calls take(p, bending) for each pair of a twisted component, in order.
+    auto forEachTwistedPair = [&](const auto &take) {
+      constexpr std::size_t block = std::size_t(1) << 20;
+      std::vector<double> bending;
+      for (std::size_t first = 0; first < pairs.size(); first += block) {
+        const std::size_t count = std::min(block, pairs.size() - first);
+        bending.assign(count, 0.0);
+        forEachIndex(count, [&](std::size_t i) {
+          if (inTwistedComponent(first + i))
+            bending[i] = bendingAt(pairs[first + i], triangles, points);
+        });
+        for (std::size_t i = 0; i < count; ++i)
+          if (inTwistedComponent(first + i))
+            take(static_cast<std::uint32_t>(first + i), bending[i]);
+      }
+    };
     bool flat_cycle_twisted = false;
-    for (std::uint32_t p : flat_pairs)
-      flat_cycle_twisted |= join(p) == ParityForest::Join::conflict;
+    forEachTwistedPair([&](std::uint32_t p, double bending) {
+      if (bending < kruskal_flat_bending)
+        flat_cycle_twisted |= join(p) == ParityForest::Join::conflict;
+      else
+        bent_pairs.push_back({bending, p});
+    });
     if (flat_cycle_twisted) {
       forest = ParityForest(triangles.size());
-      bent_pairs.insert(bent_pairs.end(), flat_pairs.begin(), flat_pairs.end());
+      bent_pairs.clear();
+      forEachTwistedPair([&](std::uint32_t p, double bending) {
+        bent_pairs.push_back({bending, p});
+      });
     }
-    std::sort(bent_pairs.begin(), bent_pairs.end(), [&](std::uint32_t p, std::uint32_t q) {
-      return bending[p] < bending[q] || (bending[p] == bending[q] && p < q);
+    std::sort(bent_pairs.begin(), bent_pairs.end(), [](const BentPair &a, const BentPair &b) {
+      return a.bending < b.bending || (a.bending == b.bending && a.pair < b.pair);
     });
     // A pair that closes a cycle leaves the forest as it is, consistent or not.
-    for (std::uint32_t p : bent_pairs)
-      join(p);
+    for (const BentPair &bent : bent_pairs)
+      join(bent.pair);
+    std::vector<BentPair>().swap(bent_pairs);
     for (std::uint32_t t = 0; t < triangles.size(); ++t)
       if (!component_orientable[triangle_component[t]] && forest.find(t).second)
         std::swap(triangles[t][1], triangles[t][2]);
+    forest = ParityForest(0);
 
     std::vector<std::uint8_t> conflict(pairs.size());
     forEachIndex(pairs.size(), [&](std::size_t p) {
@@ -342,7 +365,7 @@ std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
       };
       if (viewpoint)
         to_cut.push_back(moreEdgeOn(pairs[p]));
-      else if (bending[p] > max_untwist_bending || localTwist()) {
+      else if (bendingAt(pairs[p], triangles, points) > max_untwist_bending || localTwist()) {
         to_cut.push_back(pairs[p].first);
         to_cut.push_back(pairs[p].second);
       }

@@ -359,6 +359,7 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
       preparePoints(points, parameters.use_normals, !initial_triangles.empty(), result);
   result.timings.prepare = secondsSince(stage);
   result.peak_memory.prepare = peakResidentBytes();
+  exchange.pointsPrepared(); // `points` is not read below
 
   const bool preferred_mode = parameters.initial_triangles_mode == InitialTrianglesMode::preferred;
   const std::vector<Triangle> fixed = preferred_mode

@@ -119,6 +119,9 @@ public:
   virtual void moveTriangles(const std::vector<Transfer> &) {}
   /// Called on every process after the buckets and after each seam level.
   virtual void stageDone(const std::string & /*stage*/) {}
+  /// Called once reconstruct() has prepared its points: it reads the
+  /// PointView no more, so the memory the view points into may be freed.
+  virtual void pointsPrepared() {}
   /// Not null: this (single) process plans every unit and the farm meshes
   /// them, instead of sharing them by owner as above.
   virtual UnitFarm *farm() { return nullptr; }
