@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Tests of pcl_ms/io.h (suites Io*); the pcl_ms_reconstruct program is tested
-// in test_app.cpp. Every file they write goes to a fresh temporary directory.
+// Tests of pcl_ms/io.h (suites Io*; the STL reader's are in test_io_stl.cpp);
+// the pcl_ms_reconstruct program is tested in test_app.cpp. Every file they
+// write goes to a fresh temporary directory.
 #include "program_test.h"
 #include "test_support.h"
 

@@ -249,7 +249,8 @@ bool loadStlMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices
   Welder welder(vertices, triangles);
   // A binary header may begin with "solid" too, so the size decides, as in
   // most readers: a binary file is exactly 84 + 50 * count bytes. This is
-  // checked before anything is allocated, so an absurd count cannot be.
+  // checked before room for the facets is reserved, so an absurd count
+  // costs nothing.
   std::uint32_t count = 0;
   const std::uint64_t binary_size = binarySize(bytes, count);
   if (binary_size == bytes.size())
