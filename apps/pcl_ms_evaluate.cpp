@@ -31,7 +31,7 @@ void printHelp(const char *program) {
       "Measures a triangle mesh: topology, manifoldness, triangle shape and, optionally, how\n"
       "it compares with a reference surface and how many points of a cloud it uses.\n\n"
       "Usage: %s mesh [-gt reference] [-points cloud] [-json]\n\n"
-      "  mesh            .ply, .obj, .off or .vtk (legacy POLYDATA)\n"
+      "  mesh            .ply, .obj, .off, .vtk (legacy POLYDATA) or .stl\n"
       "  -gt FILE        reference mesh: triangle recall and precision (vertices matched by\n"
       "                  exact position), distances in both directions as fractions of the\n"
       "                  reference's bounding-box diagonal, F-scores at 0.1 %% and 0.5 %%\n"

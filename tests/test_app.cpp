@@ -22,6 +22,8 @@
 #include <filesystem>
 #include <limits>
 #include <optional>
+#include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -72,6 +74,64 @@ TEST_F(App, ReconstructsBun0IntoEveryFormat) {
   std::string error;
   ASSERT_TRUE(pcl_ms::loadPointCloud(path("bun0.ply"), cloud, error)) << error;
   EXPECT_TRUE(pcl_ms::hasNormals(cloud));
+}
+
+TEST_F(App, ReconstructsTheVerticesOfAnStlMesh) {
+  // bun0's mesh written as an ASCII STL, each corner repeated in every facet
+  // as exporters do: the program meshes the welded vertices, each position
+  // once, which are the bun0 points the mesh uses.
+  ASSERT_EQ(run(quoted(kDataDir + "/bun0.pcd") + " " + quoted(path("bun0.ply")) + " -q"), 0)
+      << stderr_;
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<pcl_ms::Triangle> triangles;
+  std::string error;
+  ASSERT_TRUE(pcl_ms::loadMesh(path("bun0.ply"), vertices, triangles, error)) << error;
+  std::ostringstream stl;
+  stl.precision(9); // every float back exactly
+  stl << "solid bun0\n";
+  std::set<std::array<double, 3>> used;
+  for (const pcl_ms::Triangle &triangle : triangles) {
+    stl << "facet normal 0 0 0\nouter loop\n";
+    for (pcl_ms::VertexIndex v : triangle) {
+      const Eigen::Vector3d &p = vertices[v];
+      stl << "vertex " << p.x() << " " << p.y() << " " << p.z() << "\n";
+      used.insert({p.x(), p.y(), p.z()});
+    }
+    stl << "endloop\nendfacet\n";
+  }
+  stl << "endsolid bun0\n";
+  writeFile(path("bun0.stl"), stl.str());
+
+  ASSERT_EQ(run(quoted(path("bun0.stl")) + " " + quoted(path("out.ply"))), 0) << stderr_;
+  EXPECT_TRUE(contains(stdout_, "triangles")) << stdout_;
+  std::vector<Eigen::Vector3d> out_vertices;
+  std::vector<pcl_ms::Triangle> out_triangles;
+  ASSERT_TRUE(pcl_ms::loadMesh(path("out.ply"), out_vertices, out_triangles, error)) << error;
+  EXPECT_EQ(out_vertices.size(), used.size());
+  std::set<std::array<double, 3>> read;
+  for (const Eigen::Vector3d &p : out_vertices)
+    read.insert({p.x(), p.y(), p.z()});
+  EXPECT_EQ(read, used);
+  // The same points in another order: the same surface (compared as corner
+  // positions, each triangle starting at its smallest corner).
+  const auto surface = [](const std::vector<Eigen::Vector3d> &points,
+                          const std::vector<pcl_ms::Triangle> &faces) {
+    std::vector<std::array<std::array<double, 3>, 3>> result;
+    for (const pcl_ms::Triangle &face : faces) {
+      std::array<std::array<double, 3>, 3> corners;
+      for (int k = 0; k < 3; ++k)
+        corners[k] = {points[face[k]].x(), points[face[k]].y(), points[face[k]].z()};
+      std::rotate(corners.begin(), std::min_element(corners.begin(), corners.end()), corners.end());
+      result.push_back(corners);
+    }
+    std::sort(result.begin(), result.end());
+    return result;
+  };
+  EXPECT_EQ(surface(out_vertices, out_triangles), surface(vertices, triangles));
+
+  // A cut file is refused with the reason.
+  writeFile(path("cut.stl"), stl.str().substr(0, stl.str().size() / 2));
+  expectFailure(quoted(path("cut.stl")) + " " + quoted(path("cut.ply")), "cut.stl: line ");
 }
 
 TEST_F(App, OptionsAndQuietMode) {

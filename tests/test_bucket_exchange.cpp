@@ -98,27 +98,26 @@ private:
   int process_;
 };
 
-/// The bunny in buckets of 4,000 points, as one process meshes it: the
-/// reference the shared runs must match.
-struct BucketedBunny {
-  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud = loadXYZ("bunny.pcd");
-  pcl_ms::Parameters parameters = [] {
-    pcl_ms::Parameters bucketed;
-    bucketed.bucket_points = 4000;
-    return bucketed;
-  }();
-  pcl_ms::Result reference = pcl_ms::reconstruct(viewOf(*cloud), parameters);
+/// The shared-bucket tests: the bunny in buckets of 4,000 points, as one
+/// process meshes it, is the reference the shared runs must match.
+class BucketExchange : public ::testing::Test {
+protected:
+  void SetUp() override {
+    cloud = loadXYZ("bunny.pcd");
+    parameters.bucket_points = 4000;
+    reference = pcl_ms::reconstruct(viewOf(*cloud), parameters);
+    // Enough buckets and seams that sharing them is exercised at all.
+    ASSERT_GE(reference.bucket_statistics.buckets, 8u);
+    ASSERT_GT(reference.bucket_statistics.seam_triangles, 0u);
+  }
+
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud;
+  pcl_ms::Parameters parameters;
+  pcl_ms::Result reference;
 };
 
-TEST(BucketExchange, ProcessesGiveTheOneProcessMesh) {
-  const BucketedBunny bunny;
-  const auto &cloud = bunny.cloud;
-  const pcl_ms::Parameters &parameters = bunny.parameters;
-  const pcl_ms::Result &reference = bunny.reference;
+TEST_F(BucketExchange, ProcessesGiveTheOneProcessMesh) {
   const pcl_ms::BucketStatistics &expected = reference.bucket_statistics;
-  ASSERT_GE(expected.buckets, 8u);
-  ASSERT_GT(expected.seam_triangles, 0u);
-
   // 3 does not divide the buckets evenly; 24 leaves some processes without a leaf.
   for (int processes : {2, 3, 24}) {
     Hub hub(processes);
@@ -187,15 +186,8 @@ private:
   pcl_ms::Parameters parameters_;
 };
 
-TEST(BucketExchange, AFarmGivesTheOneProcessMesh) {
-  const BucketedBunny bunny;
-  const auto &cloud = bunny.cloud;
-  const pcl_ms::Parameters &parameters = bunny.parameters;
-  const pcl_ms::Result &reference = bunny.reference;
+TEST_F(BucketExchange, AFarmGivesTheOneProcessMesh) {
   const pcl_ms::BucketStatistics &expected = reference.bucket_statistics;
-  ASSERT_GE(expected.buckets, 8u);
-  ASSERT_GT(expected.seam_triangles, 0u);
-
   BatchFarm farm(parameters);
   const pcl_ms::Result result = pcl_ms::reconstruct(viewOf(*cloud), parameters, farm);
   EXPECT_EQ(result.triangles, reference.triangles);
@@ -211,7 +203,7 @@ TEST(BucketExchange, AFarmGivesTheOneProcessMesh) {
   EXPECT_LE(farm.most_in_flight, 3u);
 }
 
-TEST(BucketExchange, LeavesAreSharedInContiguousRanges) {
+TEST(BucketOwner, LeavesAreSharedInContiguousRanges) {
   // 10 leaves on 4 processes: 3, 2, 3, 2 (rounded down multiples).
   std::vector<int> owners;
   for (std::size_t leaf = 0; leaf < 10; ++leaf)

@@ -49,7 +49,7 @@ TEST_F(FuzzCorpusReaders, EveryReaderLoadsOrRejectsEveryInput) {
   const std::map<std::string, std::pair<std::string, bool>> readers = {
       {"pcd", {".pcd", false}},     {"ply_cloud", {".ply", false}}, {"xyz", {".xyz", false}},
       {"mesh_ply", {".ply", true}}, {"mesh_obj", {".obj", true}},   {"mesh_off", {".off", true}},
-      {"mesh_vtk", {".vtk", true}}};
+      {"mesh_vtk", {".vtk", true}}, {"mesh_stl", {".stl", true}}};
   for (const auto &[target, reader] : readers) {
     const auto &[extension, is_mesh] = reader;
     const std::vector<fs::path> files = corpusFiles(target);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Tests of pcl_ms/io.h (suites Io*); the pcl_ms_reconstruct program is tested
-// in test_app.cpp. Every file they write goes to a fresh temporary directory.
+// Tests of pcl_ms/io.h (suites Io*; the STL reader's are in test_io_stl.cpp);
+// the pcl_ms_reconstruct program is tested in test_app.cpp. Every file they
+// write goes to a fresh temporary directory.
 #include "program_test.h"
 #include "test_support.h"
 
@@ -106,29 +107,6 @@ void expectSameCloud(const pcl::PointCloud<pcl::PointNormal> &expected,
       EXPECT_NEAR(actual[i].normal_z, expected[i].normal_z, tolerance) << "point " << i;
     }
   }
-}
-
-/// Loads and expects failure with a one-line reason that names the file.
-std::string expectCloudFailure(const std::string &file) {
-  pcl::PCLPointCloud2 cloud;
-  std::string error;
-  EXPECT_FALSE(pcl_ms::loadPointCloud(file, cloud, error)) << file;
-  EXPECT_NE(error.find(file), std::string::npos) << error;
-  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
-  EXPECT_EQ(cloud.width * cloud.height, 0u);
-  return error;
-}
-
-std::string expectMeshFailure(const std::string &file) {
-  std::vector<Eigen::Vector3d> vertices;
-  std::vector<pcl_ms::Triangle> triangles;
-  std::string error;
-  EXPECT_FALSE(pcl_ms::loadMesh(file, vertices, triangles, error)) << file;
-  EXPECT_NE(error.find(file), std::string::npos) << error;
-  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
-  EXPECT_TRUE(vertices.empty());
-  EXPECT_TRUE(triangles.empty());
-  return error;
 }
 
 // ---------------------------------------------------------------------------
@@ -669,7 +647,7 @@ TEST_F(IoLoadMesh, GarbageMissingEmptyAndUnknownFail) {
   std::string garbage(4096, '\0');
   for (char &byte : garbage)
     byte = static_cast<char>(random());
-  for (const char *name : {"noise.ply", "noise.off", "noise.obj", "noise.vtk"}) {
+  for (const char *name : {"noise.ply", "noise.off", "noise.obj", "noise.vtk", "noise.stl"}) {
     writeFile(path(name), garbage);
     expectMeshFailure(path(name));
     writeFile(path(std::string("empty_") + name), "");
@@ -678,8 +656,8 @@ TEST_F(IoLoadMesh, GarbageMissingEmptyAndUnknownFail) {
   EXPECT_TRUE(contains(expectMeshFailure(path("missing.ply")), "does not exist"));
   fs::create_directory(path("folder.off"));
   EXPECT_TRUE(contains(expectMeshFailure(path("folder.off")), "directory"));
-  writeFile(path("mesh.stl"), "solid x\nendsolid x\n");
-  EXPECT_TRUE(contains(expectMeshFailure(path("mesh.stl")), "unknown"));
+  writeFile(path("mesh.wrl"), "#VRML V2.0 utf8\n");
+  EXPECT_TRUE(contains(expectMeshFailure(path("mesh.wrl")), "unknown"));
 }
 
 // ---------------------------------------------------------------------------

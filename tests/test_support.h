@@ -44,4 +44,29 @@ template <typename PointT> pcl_ms::PointView viewOf(const pcl::PointCloud<PointT
   return view;
 }
 
+/// Loads a cloud and expects failure with a one-line reason that names the
+/// file; returns the reason.
+inline std::string expectCloudFailure(const std::string &file) {
+  pcl::PCLPointCloud2 cloud;
+  std::string error;
+  EXPECT_FALSE(pcl_ms::loadPointCloud(file, cloud, error)) << file;
+  EXPECT_NE(error.find(file), std::string::npos) << error;
+  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+  EXPECT_EQ(cloud.width * cloud.height, 0u);
+  return error;
+}
+
+/// The same for a mesh.
+inline std::string expectMeshFailure(const std::string &file) {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<pcl_ms::Triangle> triangles;
+  std::string error;
+  EXPECT_FALSE(pcl_ms::loadMesh(file, vertices, triangles, error)) << file;
+  EXPECT_NE(error.find(file), std::string::npos) << error;
+  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+  EXPECT_TRUE(vertices.empty());
+  EXPECT_TRUE(triangles.empty());
+  return error;
+}
+
 } // namespace pcl_ms_test

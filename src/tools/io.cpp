@@ -381,8 +381,9 @@ bool hasNormals(const pcl::PCLPointCloud2 &cloud) {
 
 namespace {
 
-/// The vertices of an .obj, .off or .vtk mesh as a cloud, in file order;
-/// faces may be absent (a vertex-only OFF is a point cloud).
+/// The vertices of an .obj, .off, .vtk or .stl mesh as a cloud, in file
+/// order (an STL's welded vertices in order of first use); faces may be
+/// absent (a vertex-only OFF is a point cloud).
 bool loadMeshVerticesCloud(const std::string &path, pcl::PCLPointCloud2 &cloud,
                            std::string &reason) {
   std::vector<Eigen::Vector3d> vertices;
@@ -427,11 +428,13 @@ bool loadPointCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::st
       ok = loadPlyCloud(path, size, cloud, reason);
     else if (extension == ".xyz" || extension == ".txt")
       ok = loadXyzCloud(path, cloud, reason);
-    else if (extension == ".obj" || extension == ".off" || extension == ".vtk")
+    else if (extension == ".obj" || extension == ".off" || extension == ".vtk" ||
+             extension == ".stl")
       ok = loadMeshVerticesCloud(path, cloud, reason);
     else
-      reason = unknownFormat(extension, "point cloud",
-                             ".pcd, .ply, .xyz, .txt, or a mesh's vertices: .obj, .off, .vtk");
+      reason =
+          unknownFormat(extension, "point cloud",
+                        ".pcd, .ply, .xyz, .txt, or a mesh's vertices: .obj, .off, .vtk, .stl");
     ok = ok && checkCloudLayout(cloud, reason);
   } catch (const std::exception &exception) {
     reason = std::string("unexpected failure: ") + exception.what();

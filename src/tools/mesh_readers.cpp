@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Mesh readers for .ply, .obj, .off and legacy .vtk (see mesh_readers.h),
-// and loadMesh() on top of them (mesh_file.h).
+// and loadMesh() on top of them and the STL reader (mesh_file.h).
 #include "mesh_readers.h"
 
 #include "io_parsing.h"
@@ -695,7 +695,9 @@ bool readMeshFile(const std::string &path, std::vector<Eigen::Vector3d> &vertice
     return loadOffMesh(path, vertices, triangles, reason);
   if (extension == ".vtk")
     return loadVtkMesh(path, vertices, triangles, reason);
-  reason = unknownFormat(extension, "mesh", ".ply, .obj, .off or .vtk");
+  if (extension == ".stl")
+    return loadStlMesh(path, vertices, triangles, reason);
+  reason = unknownFormat(extension, "mesh", ".ply, .obj, .off, .vtk or .stl");
   return false;
 }
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Mesh readers of our own for .ply, .obj, .off and legacy .vtk, so that every
-// format reports the same kind of errors. Internal to the library: not
+// Mesh readers of our own for .ply, .obj, .off, legacy .vtk and .stl, so that
+// every format reports the same kind of errors. Internal to the library: not
 // installed; loadMesh() in mesh_file.h is the entry for the tools.
 #pragma once
 
@@ -21,6 +21,12 @@ bool loadObjMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices
 bool loadOffMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices,
                  std::vector<Triangle> &triangles, std::string &error);
 bool loadVtkMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices,
+                 std::vector<Triangle> &triangles, std::string &error);
+/// ASCII or binary STL (stl_reader.cpp). Corners at bitwise-equal float
+/// positions (-0 counted as +0) become one vertex, numbered in order of first
+/// use; facets left with two equal corners are dropped. Non-finite
+/// coordinates are an error.
+bool loadStlMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices,
                  std::vector<Triangle> &triangles, std::string &error);
 
 } // namespace io_detail

@@ -66,7 +66,7 @@ void printReconstructHelp(const char *program, const char *summary) {
   print_info("%s\n\n", summary);
   print_info("Usage: %s input output [options]\n\n", program);
   print_info("  input   point cloud: .pcd, .ply, .xyz or .txt (x y z [nx ny nz] per line), or\n"
-             "          the vertices of a mesh: .obj, .off or .vtk\n");
+             "          the vertices of a mesh: .obj, .off, .vtk or .stl\n");
   print_info("  output  mesh: .ply (binary), .vtk or .obj; its vertices are the input points, in\n"
              "          order, with colours and normals where the format can hold them\n\n");
   print_info("Options:\n");
@@ -102,8 +102,9 @@ void printReconstructHelp(const char *program, const char *summary) {
   print_info("  -no_viewpoint   no viewpoint, even for an organized cloud\n");
   print_info("  -time_limit S   give up after S seconds with an error and no output file,\n"
              "                  0 = no limit (default 0)\n");
-  print_info("  -initial MESH   a partial mesh or polygon soup (.ply, .obj, .off or .vtk) whose\n"
-             "                  vertices are input points: its triangles start the surface\n");
+  print_info("  -initial MESH   a partial mesh or polygon soup (.ply, .obj, .off, .vtk or\n"
+             "                  .stl) whose vertices are input points: its triangles start\n"
+             "                  the surface\n");
   print_info("  -initial_mode fixed|preferred  fixed (default): the initial triangles stay and\n"
              "                  must be edge-manifold; preferred: they are accepted first but\n"
              "                  undone where they conflict, so a soup with wrong, overlapping\n"

@@ -25,7 +25,9 @@ namespace pcl_ms {
 ///  - .xyz / .txt: whitespace-separated columns, 3 (x y z) or 6 (x y z nx ny
 ///    nz) per line; blank lines and `#` comments are skipped;
 ///  - .obj, .off, .vtk (legacy POLYDATA): the vertices of a mesh, in file
-///    order, as x y z (faces, if any, are read and dropped).
+///    order, as x y z (faces, if any, are read and dropped);
+///  - .stl (ascii or binary): the mesh's vertices, each position once (STL
+///    repeats a corner in every facet), in order of first use.
 /// On success `cloud` has FLOAT32 fields x, y, z (plus whatever else the file
 /// holds) and at least one point. On failure `cloud` is left empty.
 /// `sensor_origin`, when given, receives a PCD file's VIEWPOINT position

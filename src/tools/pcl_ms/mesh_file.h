@@ -17,9 +17,12 @@ namespace pcl_ms {
 std::string fileExtension(const std::string &path);
 
 /// Loads a triangle mesh (for instance a reference surface) from .ply, .obj,
-/// .off or legacy .vtk (POLYDATA, ascii or binary). Polygons with more than
-/// three corners are fan-triangulated. Fails on meshes without faces and on
-/// faces that reference missing vertices.
+/// .off, legacy .vtk (POLYDATA, ascii or binary) or .stl (ascii or binary).
+/// Polygons with more than three corners are fan-triangulated. STL repeats
+/// each corner in every facet: corners at the same float position become one
+/// vertex (numbered in order of first use) and facets left with two equal
+/// corners are dropped. Fails on meshes without faces, on faces that
+/// reference missing vertices and on non-finite STL coordinates.
 bool loadMesh(const std::string &path, std::vector<Eigen::Vector3d> &vertices,
               std::vector<Triangle> &triangles, std::string &error);
 
