@@ -24,7 +24,7 @@ struct EdgeUse {
 /// Calls visit(key, first, count) for each distinct edge in key order, with
 /// its `count` incidences at [first, first + count), sorted by triangle. A
 /// 20M-triangle surface has 60M incidences: holding them all beside the
-/// triangles, points and pairs set the peak of a whole MPI run's rank 0
+/// triangles, points and neighbours set the peak of a whole MPI run's rank 0
 /// (docs/algorithm.md, "Across processes"), so they are sorted in blocks.
 template <typename Visit>
 void forEachEdge(const std::vector<Triangle> &triangles, std::size_t block_uses, Visit &&visit) {
@@ -77,14 +77,25 @@ void forEachEdge(const std::vector<Triangle> &triangles, std::size_t block_uses,
 
 } // namespace
 
-MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_pairs,
+MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_neighbours,
                     std::size_t block_uses) {
   MeshEdges edges;
+  if (with_neighbours)
+    edges.neighbours.assign(3 * triangles.size(), no_neighbour);
+  // Edges come in key order, so each triangle's slots fill in that order.
+  auto addNeighbour = [&](std::uint32_t t, std::uint32_t u) {
+    std::uint32_t *slot = &edges.neighbours[3 * std::size_t{t}];
+    while (*slot != no_neighbour) // a triangle has three edges: a slot is free
+      ++slot;
+    *slot = u;
+  };
   forEachEdge(triangles, block_uses, [&](EdgeKey key, const EdgeUse *first, std::size_t count) {
-    if (count == 1)
+    if (count == 1) {
       edges.boundary.push_back(key);
-    else if (count == 2 && with_pairs)
-      edges.pairs.push_back({first[0].triangle, first[1].triangle});
+    } else if (count == 2 && with_neighbours) {
+      addNeighbour(first[0].triangle, first[1].triangle);
+      addNeighbour(first[1].triangle, first[0].triangle);
+    }
   });
   return edges;
 }
@@ -168,8 +179,9 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
       surface.boundary_loops = detail::boundaryLoops(edges.boundary);
     }
     surface.holes_filled += filled;
-    return detail::orientPairs(triangles, edges.pairs, points, surface.triangle_component,
-                               surface.component_orientable, viewpoint);
+    return detail::orientAlongNeighbours(triangles, edges.neighbours, points,
+                                         surface.triangle_component, surface.component_orientable,
+                                         viewpoint);
   };
   std::vector<std::uint32_t> to_cut = fillThenOrient(fill_holes_max_edges, nullptr);
   for (int round = 0; round < max_untwist_rounds && !to_cut.empty(); ++round) {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Stage 4's steps and the mesh structure they share (docs/algorithm.md
 // section 4). In: a triangle list. Out: boundary edges and loops, manifold
-// pairs (finish.cpp), filled holes (hole_filling.cpp), orientation and cuts
+// neighbours (finish.cpp), filled holes (hole_filling.cpp), orientation and cuts
 // (orientation.cpp), dropped triangles (bow_ties.cpp). Internal: not installed.
 #pragma once
 
@@ -32,24 +32,24 @@ template <typename Work> void forEachIndex(std::size_t count, const Work &work) 
                     });
 }
 
-/// Two triangles sharing a manifold edge, first < second (the edge and how
-/// much the surface bends there are computed where orientation needs them:
-/// 8 bytes a pair keep the finishing of a whole 10M-point surface lean).
-struct ManifoldPair {
-  std::uint32_t first, second;
-};
+inline constexpr std::uint32_t no_neighbour = 0xffffffffu;
 
-/// What one scan of a triangle list's edges finds, both in edge-key order.
+/// What one scan of a triangle list's edges finds.
 struct MeshEdges {
-  std::vector<EdgeKey> boundary;   // edges with one triangle
-  std::vector<ManifoldPair> pairs; // edges with two (only when asked for)
+  /// Edges with one triangle, in key order.
+  std::vector<EdgeKey> boundary;
+  /// Only when asked for: three slots per triangle holding the triangles
+  /// across its manifold edges (edges with two triangles) in the order of
+  /// those edges' keys, then no_neighbour. 12 bytes a triangle: at 10M
+  /// points a list of pairs and each triangle's pairs took twice that.
+  std::vector<std::uint32_t> neighbours;
 };
 
 /// Scans every edge of `triangles` once. The (edge, triangle) incidences are
 /// sorted a block of lower vertices at a time, at most `block_uses` per
 /// block (16M: 128 MB), so that finishing a 20M-triangle surface never holds
 /// them all. The result does not depend on the block size.
-MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_pairs,
+MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_neighbours,
                     std::size_t block_uses = std::size_t(1) << 24);
 
 /// Cyclic boundary loops traced along boundary edges (sorted), each starting
@@ -66,13 +66,13 @@ std::size_t fillLoops(std::vector<Triangle> &triangles, std::vector<std::vector<
                       const std::vector<Eigen::Vector3d> &points, int max_edges,
                       const SideLimit &limit, const std::vector<bool> *only_around);
 
-/// orientComponents() given the mesh's manifold pairs.
-std::vector<std::uint32_t> orientPairs(std::vector<Triangle> &triangles,
-                                       const std::vector<ManifoldPair> &pairs,
-                                       const std::vector<Eigen::Vector3d> &points,
-                                       std::vector<std::uint32_t> &triangle_component,
-                                       std::vector<bool> &component_orientable,
-                                       const Eigen::Vector3d *viewpoint);
+/// orientComponents() given the mesh's manifold neighbours (MeshEdges).
+std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangles,
+                                                 const std::vector<std::uint32_t> &neighbours,
+                                                 const std::vector<Eigen::Vector3d> &points,
+                                                 std::vector<std::uint32_t> &triangle_component,
+                                                 std::vector<bool> &component_orientable,
+                                                 const Eigen::Vector3d *viewpoint);
 
 /// Drops the marked triangles; their corners are marked in touched.
 void dropTriangles(std::vector<Triangle> &triangles, const std::vector<bool> &drop,
