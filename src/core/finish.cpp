@@ -40,6 +40,7 @@ void forEachEdge(const std::vector<Triangle> &triangles, std::size_t block_uses,
   for (std::size_t v = 0; v < vertex_count; ++v)
     offsets[v + 1] += offsets[v];
   std::vector<EdgeUse> uses;
+  uses.reserve(std::min<std::uint64_t>(block_uses, offsets[vertex_count])); // no regrowth
   std::vector<std::uint32_t> cursor;
   for (VertexIndex begin = 0; begin < vertex_count;) {
     VertexIndex end = begin + 1;
@@ -167,17 +168,16 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
                               const SideLimit &limit, const std::vector<bool> *anchored_vertices,
                               const Eigen::Vector3d *viewpoint) {
   FinishedSurface surface;
-  // The edges are scanned once per set of triangles.
   auto fillThenOrient = [&](int max_edges, const std::vector<bool> *only_around) {
-    detail::MeshEdges edges = detail::meshEdges(triangles, true);
-    surface.boundary_loops = detail::boundaryLoops(edges.boundary);
+    // Holes first, with only the boundary in hand: a filling grows the
+    // triangle list, which then briefly exists twice, so the neighbours (as
+    // large) are found after it.
+    surface.boundary_loops = detail::boundaryLoops(detail::meshEdges(triangles, false).boundary);
     const std::size_t filled =
         detail::fillLoops(triangles, surface.boundary_loops, points, max_edges, limit, only_around);
-    if (filled > 0) {
-      edges = detail::MeshEdges(); // freed before the new scan
-      edges = detail::meshEdges(triangles, true);
+    const detail::MeshEdges edges = detail::meshEdges(triangles, true);
+    if (filled > 0)
       surface.boundary_loops = detail::boundaryLoops(edges.boundary);
-    }
     surface.holes_filled += filled;
     return detail::orientAlongNeighbours(triangles, edges.neighbours, points,
                                          surface.triangle_component, surface.component_orientable,
