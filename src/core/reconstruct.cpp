@@ -23,6 +23,10 @@
 #include <sstream>
 #include <tuple>
 
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
+
 namespace pcl_ms {
 
 std::string Parameters::validate() const {
@@ -85,6 +89,17 @@ std::size_t peakResidentBytes() {
     if (line.compare(0, 6, "VmHWM:") == 0)
       return static_cast<std::size_t>(std::strtoull(line.c_str() + 6, nullptr, 10)) * 1024;
   return 0;
+}
+
+/// Hands the heap's free pages back to the system. The bucket threads'
+/// small allocations leave them scattered through each thread's heap, where
+/// they stayed resident through the finishing and the caller's conversion
+/// of the result: at 10M points, handing them back lowered the peak by
+/// about 0.5 GB (docs/algorithm.md, section 4, "Memory").
+void returnFreeHeapPages() {
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
 }
 
 /// The distinct, finite points of the user's records, centred on their
@@ -386,6 +401,7 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
     deadline.check("the preparation");
     BucketedSurface bucketed =
         meshInBuckets(prepared.positions, normals, parameters, &deadline, &exchange);
+    returnFreeHeapPages();
     triangles = std::move(bucketed.triangles);
     local_scale = std::move(bucketed.local_scale);
     result.d_med = bucketed.d_med;
