@@ -84,6 +84,12 @@ TEST(Bunny, RecoversTheReferenceSurface) {
   EXPECT_LE(memory.prepare, memory.scaffold);
   EXPECT_LE(memory.scaffold, memory.greedy);
   EXPECT_LE(memory.greedy, memory.finish);
+  // Every Delaunay triangle is counted once: kept by type, too long, or flat.
+  const pcl_ms::Result &counts = bunny.result;
+  EXPECT_GT(counts.candidates_type1, counts.candidates_type2);
+  EXPECT_GT(counts.candidates_type3, 0u);
+  EXPECT_GT(counts.candidates_oversize, counts.candidates_type1);
+  EXPECT_EQ(counts.candidates_degenerate, 0u);
 
   const ReferenceMesh &reference = bunnyReference();
   const std::vector<Eigen::Vector3d> vertices = positions(*loadXYZ("bunny.pcd"));

@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <limits>
+#include <utility>
 
 namespace {
 
@@ -49,7 +50,7 @@ TEST(TimeLimit, TheGreedyPassesAreStoppedFromInside) {
   pcl_ms::MedialScaffold scaffold = pcl_ms::buildMedialScaffold(points, options);
   const pcl_ms::Deadline expired(1e-9);
   const pcl_ms::Parameters parameters; // outlives the mesher, which keeps a reference
-  pcl_ms::GreedyMesher mesher(scaffold, points, parameters, &expired);
+  pcl_ms::GreedyMesher mesher(std::move(scaffold), points, parameters, &expired);
   EXPECT_THROW(mesher.run(), pcl_ms::TimeLimitExceeded);
 }
 

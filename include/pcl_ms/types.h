@@ -236,6 +236,9 @@ struct Result {
 
   std::size_t candidates_type1 = 0, candidates_type2 = 0, candidates_type3 = 0;
   std::size_t candidates_oversize = 0;
+  /// Delaunay triangles whose corners are collinear (left out). Exact
+  /// predicates should keep this 0; it is counted so that a breach shows.
+  std::size_t candidates_degenerate = 0;
   /// Summaries: the median Gabriel circumradius and rho times it. The size
   /// limit itself is local (Parameters::rho).
   double d_med = 0, d_max = 0;

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Stage 4, bow-ties (docs/algorithm.md section 4, "Twists"). In: a triangle
-// list and the vertices to check. Out: the list with one fan (the largest)
-// left at each of them; corners of removed triangles are checked in turn.
+// Stage 4, bow-ties (docs/algorithm.md section 4, "Bow-ties"). In: a triangle
+// list and the vertices to check. Out: the list with one fan (the largest,
+// by the rule of fan_choice.h) left at each of them; corners of removed
+// triangles are checked in turn.
+#include "fan_choice.h"
 #include "finish_steps.h"
 
 #include <pcl_ms/mesh_topology.h>
@@ -100,10 +102,11 @@ std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_co
       const auto fans = detail::fansAt(v, incidence.atSlot(slot), triangles);
       if (fans.size() < 2)
         continue;
-      std::size_t keep = 0;
-      for (std::size_t f = 1; f < fans.size(); ++f)
-        if (fans[f].size() > fans[keep].size())
-          keep = f;
+      const std::size_t keep = detail::fanToKeep(fans.size(), [&](std::size_t f) {
+        detail::FanWeight weight;
+        weight.size = fans[f].size();
+        return weight;
+      });
       for (std::size_t f = 0; f < fans.size(); ++f)
         if (f != keep)
           for (std::uint32_t t : fans[f])

@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 
 namespace pcl_ms {
 namespace {
@@ -27,17 +26,17 @@ constexpr std::uint8_t max_undos = 3;
 
 } // namespace
 
-GreedyMesher::Impl::Impl(MedialScaffold &scaffold, const std::vector<Eigen::Vector3d> &points,
+GreedyMesher::Impl::Impl(MedialScaffold &&scaffold, const std::vector<Eigen::Vector3d> &points,
                          const Parameters &parameters, const Deadline *deadline,
                          GreedyStatistics &statistics)
-    : scaffold_(scaffold), candidates_(scaffold.candidates), points_(points),
-      parameters_(parameters), deadline_(deadline), statistics_(statistics),
-      mesh_(scaffold, points.size()), states_(candidates_.size()),
+    : graph_(std::move(scaffold)), scaffold_(graph_.scaffold()), candidates_(graph_.candidates()),
+      points_(points), parameters_(parameters), deadline_(deadline), statistics_(statistics),
+      mesh_(scaffold_, points.size()), states_(candidates_.size()),
       is_fixed_(candidates_.size(), false), is_preferred_(candidates_.size(), false),
       multi_fan_vertex_(points.size(), false), may_have_several_fans_(points.size(), false) {
-  for (CandidateIndex t : scaffold.fixed)
+  for (CandidateIndex t : scaffold_.fixed)
     is_fixed_[t] = true;
-  for (CandidateIndex t : scaffold.preferred)
+  for (CandidateIndex t : scaffold_.preferred)
     is_preferred_[t] = !is_fixed_[t];
   delay_multiplier_.resize(2 * static_cast<std::size_t>(parameters.max_delays) + 1);
   for (std::size_t k = 0; k < delay_multiplier_.size(); ++k)
@@ -244,7 +243,8 @@ void GreedyMesher::Impl::buildQueue2(PassStatistics &statistics) {
     }
     members.push_back(t);
   }
-  listLateCandidates(members);
+  graph_.addLateCandidates(members);
+  mesh_.growEdges(edgeCount());
   queue2_built_ = true;
   for (CandidateIndex t : members) {
     states_[t].context = contextFromScratch(t);
@@ -252,52 +252,6 @@ void GreedyMesher::Impl::buildQueue2(PassStatistics &statistics) {
     ++queued_[1];
     enqueue(t, State::queue2);
   }
-}
-
-/// The edge joining a and b: the scaffold's, one numbered here, or no_edge.
-EdgeIndex GreedyMesher::Impl::findEdge(VertexIndex a, VertexIndex b) const {
-  const EdgeIndex e = scaffold_.findEdge(a, b);
-  if (e != no_edge || new_edges_.empty())
-    return e;
-  const auto found = new_edges_.find(detail::edgeKey(a, b));
-  return found == new_edges_.end() ? no_edge : found->second;
-}
-
-/// Gives a type III candidate the ids of its edges, numbering the edges
-/// that no pass-1 candidate has.
-void GreedyMesher::Impl::numberEdges(CandidateIndex t) {
-  Candidate &candidate = candidates_[t];
-  for (int k = 0; k < 3; ++k) {
-    const VertexIndex a = candidate.vertices[k], b = candidate.vertices[(k + 1) % 3];
-    EdgeIndex e = findEdge(a, b);
-    if (e == no_edge) {
-      e = static_cast<EdgeIndex>(edgeCount());
-      new_edges_.emplace(detail::edgeKey(a, b), e);
-    }
-    candidate.edges[k] = e;
-  }
-  mesh_.growEdges(edgeCount());
-}
-
-/// Numbers the edges of the type III members of Q2 and lists them per
-/// edge, as the scaffold lists the pass-1 candidates.
-void GreedyMesher::Impl::listLateCandidates(const std::vector<CandidateIndex> &members) {
-  std::vector<CandidateIndex> late;
-  for (CandidateIndex t : members)
-    if (!hasEdges(t)) {
-      numberEdges(t);
-      late.push_back(t);
-    }
-  late_offsets_.assign(edgeCount() + 1, 0);
-  for (CandidateIndex t : late)
-    for (EdgeIndex e : candidates_[t].edges)
-      ++late_offsets_[e + 1];
-  std::partial_sum(late_offsets_.begin(), late_offsets_.end(), late_offsets_.begin());
-  late_candidates_.resize(late_offsets_.back());
-  std::vector<std::uint32_t> cursor(late_offsets_.begin(), late_offsets_.end() - 1);
-  for (CandidateIndex t : late)
-    for (EdgeIndex e : candidates_[t].edges)
-      late_candidates_[cursor[e]++] = t;
 }
 
 void GreedyMesher::Impl::runPass(State queue_state, PassStatistics &statistics) {
@@ -506,9 +460,10 @@ void GreedyMesher::Impl::removeFlapsAndIsolatedTriangles() {
   statistics_.cleanup_undone += loose.size();
 }
 
-GreedyMesher::GreedyMesher(MedialScaffold &scaffold, const std::vector<Eigen::Vector3d> &points,
+GreedyMesher::GreedyMesher(MedialScaffold &&scaffold, const std::vector<Eigen::Vector3d> &points,
                            const Parameters &parameters, const Deadline *deadline)
-    : impl_(std::make_unique<Impl>(scaffold, points, parameters, deadline, statistics_)) {}
+    : impl_(
+          std::make_unique<Impl>(std::move(scaffold), points, parameters, deadline, statistics_)) {}
 
 GreedyMesher::~GreedyMesher() = default;
 

@@ -5,8 +5,8 @@
 // greedy_seams.cpp (seam detection, seam pass). Internal: not installed.
 #pragma once
 
+#include "candidate_graph.h"
 #include "candidate_queue.h"
-#include "edge_key.h"
 
 #include <pcl_ms/greedy.h>
 
@@ -37,7 +37,7 @@ struct SeamAxis {
 
 class GreedyMesher::Impl {
 public:
-  Impl(MedialScaffold &scaffold, const std::vector<Eigen::Vector3d> &points,
+  Impl(MedialScaffold &&scaffold, const std::vector<Eigen::Vector3d> &points,
        const Parameters &parameters, const Deadline *deadline, GreedyStatistics &statistics);
 
   void run();
@@ -92,39 +92,14 @@ private:
   void push(CandidateIndex t, State queue);
   void buildQueue2(PassStatistics &statistics);
 
-  // ---- the candidate graph and the edges of type III candidates (greedy.cpp)
+  // ---- the candidate graph (candidate_graph.h) -----------------------------
 
-  /// Visits the candidates on edge e, in ascending order within each group:
-  /// the scaffold's (types I and II, fixed), the type III ones that reached
-  /// pass 2, then any that a diagonal swap brought in. Stops when visit
-  /// returns true, and says whether it did.
   template <typename Visit> bool forEachCandidateOn(EdgeIndex e, const Visit &visit) const {
-    if (e < scaffold_.numberOfEdges())
-      for (const CandidateIndex *s = scaffold_.edgeBegin(e); s != scaffold_.edgeEnd(e); ++s)
-        if (visit(*s))
-          return true;
-    if (e + std::size_t{1} < late_offsets_.size())
-      for (std::uint32_t i = late_offsets_[e]; i < late_offsets_[e + 1]; ++i)
-        if (visit(late_candidates_[i]))
-          return true;
-    if (!swapped_in_.empty()) {
-      const auto found = swapped_in_.find(e);
-      if (found != swapped_in_.end())
-        for (CandidateIndex s : found->second)
-          if (visit(s))
-            return true;
-    }
-    return false;
+    return graph_.forEachCandidateOn(e, visit);
   }
-
-  bool hasEdges(CandidateIndex t) const { return candidates_[t].edges[0] != no_edge; }
-
-  /// The scaffold's edges and those numbered here, which follow them.
-  std::size_t edgeCount() const { return scaffold_.numberOfEdges() + new_edges_.size(); }
-
-  EdgeIndex findEdge(VertexIndex a, VertexIndex b) const;
-  void numberEdges(CandidateIndex t);
-  void listLateCandidates(const std::vector<CandidateIndex> &members);
+  bool hasEdges(CandidateIndex t) const { return graph_.hasEdges(t); }
+  std::size_t edgeCount() const { return graph_.edgeCount(); }
+  EdgeIndex findEdge(VertexIndex a, VertexIndex b) const { return graph_.findEdge(a, b); }
 
   VertexIndex apexOf(CandidateIndex t, VertexIndex a, VertexIndex c) const {
     for (VertexIndex v : candidates_[t].vertices)
@@ -164,8 +139,6 @@ private:
 
   EdgeIndex edgeBetween(CandidateIndex t, VertexIndex a, VertexIndex b) const;
   CandidateIndex candidateWith(EdgeIndex e, VertexIndex a, VertexIndex b, VertexIndex apex) const;
-  void listUnnumberedCandidates();
-  void bringInBySwap(CandidateIndex t);
   bool oppositeAnglesExceedPi(VertexIndex b, VertexIndex d, VertexIndex a, VertexIndex c) const;
   void swapNonDelaunayDiagonals();
   void enforceManifoldVertices();
@@ -210,8 +183,9 @@ private:
 
   // ---- state ---------------------------------------------------------------
 
-  MedialScaffold &scaffold_;
-  std::vector<Candidate> &candidates_;
+  detail::CandidateGraph graph_; // owns the scaffold from here on
+  const MedialScaffold &scaffold_;
+  const std::vector<Candidate> &candidates_;
   const std::vector<Eigen::Vector3d> &points_;
   const Parameters &parameters_;
   const Deadline *deadline_; // null: no time limit
@@ -233,14 +207,6 @@ private:
   std::vector<bool> multi_fan_vertex_;
   std::vector<bool> may_have_several_fans_;
   std::vector<double> delay_multiplier_;
-  // Edges numbered here (type III candidates): their ids by end points, and
-  // who is on them.
-  std::unordered_map<detail::EdgeKey, EdgeIndex> new_edges_;
-  std::vector<std::uint32_t> late_offsets_;
-  std::vector<CandidateIndex> late_candidates_;
-  std::unordered_map<EdgeIndex, std::vector<CandidateIndex>> swapped_in_;
-  std::vector<std::uint32_t> unnumbered_offsets_; // by lowest vertex, during swaps
-  std::vector<CandidateIndex> unnumbered_;
   // Seam pass: its triangles in order, per edge, and flags.
   std::vector<CandidateIndex> seam_list_;
   std::unordered_map<EdgeIndex, std::vector<CandidateIndex>> seam_on_edge_;

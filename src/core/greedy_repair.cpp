@@ -3,13 +3,13 @@
 // the passes accepted. Out: the same with non-Delaunay quads swapped for the
 // other diagonal where that bends the surface no more, and one fan per vertex
 // (the manifold sweep).
+#include "fan_choice.h"
 #include "greedy_impl.h"
 
 #include <pcl_ms/costs.h>
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <stdexcept>
 #include <string>
 
@@ -42,8 +42,7 @@ EdgeIndex GreedyMesher::Impl::edgeBetween(CandidateIndex t, VertexIndex a, Verte
 
 /// The candidate (a, b, apex), where a and b are the ends of edge e, or
 /// no_candidate: on e's lists, else among the type III candidates without
-/// edges (unnumbered_, by lowest vertex). Vertex sets are unique, so where
-/// it is found does not matter.
+/// edges. Vertex sets are unique, so where it is found does not matter.
 CandidateIndex GreedyMesher::Impl::candidateWith(EdgeIndex e, VertexIndex a, VertexIndex b,
                                                  VertexIndex apex) const {
   CandidateIndex found = no_candidate;
@@ -53,38 +52,11 @@ CandidateIndex GreedyMesher::Impl::candidateWith(EdgeIndex e, VertexIndex a, Ver
       found = s;
     return found != no_candidate;
   });
-  if (found != no_candidate || unnumbered_offsets_.empty())
+  if (found != no_candidate)
     return found;
   Triangle vertices = {a, b, apex};
   std::sort(vertices.begin(), vertices.end());
-  for (std::uint32_t i = unnumbered_offsets_[vertices[0]]; i < unnumbered_offsets_[vertices[0] + 1];
-       ++i)
-    if (candidates_[unnumbered_[i]].vertices == vertices)
-      return unnumbered_[i];
-  return no_candidate;
-}
-
-/// Lists the type III candidates still without edges by lowest vertex.
-void GreedyMesher::Impl::listUnnumberedCandidates() {
-  unnumbered_offsets_.assign(points_.size() + 1, 0);
-  for (CandidateIndex t = 0; t < candidates_.size(); ++t)
-    if (!hasEdges(t))
-      ++unnumbered_offsets_[candidates_[t].vertices[0] + 1];
-  std::partial_sum(unnumbered_offsets_.begin(), unnumbered_offsets_.end(),
-                   unnumbered_offsets_.begin());
-  unnumbered_.resize(unnumbered_offsets_.back());
-  std::vector<std::uint32_t> cursor(unnumbered_offsets_.begin(), unnumbered_offsets_.end() - 1);
-  for (CandidateIndex t = 0; t < candidates_.size(); ++t)
-    if (!hasEdges(t))
-      unnumbered_[cursor[candidates_[t].vertices[0]]++] = t;
-}
-
-/// Numbers the edges of a type III candidate that a swap brings into the
-/// mesh (pass 2 had dropped it) and lists it on them.
-void GreedyMesher::Impl::bringInBySwap(CandidateIndex t) {
-  numberEdges(t);
-  for (EdgeIndex e : candidates_[t].edges)
-    swapped_in_[e].push_back(t);
+  return graph_.unnumberedWith(vertices);
 }
 
 /// Whether the angles at b and d opposite edge ac sum to more than pi
@@ -108,7 +80,7 @@ bool GreedyMesher::Impl::oppositeAnglesExceedPi(VertexIndex b, VertexIndex d, Ve
 /// ridges stay). On curved surfaces the 3-D empty-sphere test alone often
 /// picks the diagonal a surface triangulation would not.
 void GreedyMesher::Impl::swapNonDelaunayDiagonals() {
-  listUnnumberedCandidates();
+  graph_.listUnnumbered(points_.size());
   std::vector<EdgeIndex> work;
   std::vector<bool> queued(edgeCount(), false);
   auto enqueue = [&](EdgeIndex e) {
@@ -164,8 +136,10 @@ void GreedyMesher::Impl::swapNonDelaunayDiagonals() {
       states_[old].state = State::dropped;
     }
     for (CandidateIndex replacement : {abd, bcd})
-      if (!hasEdges(replacement))
-        bringInBySwap(replacement);
+      if (!hasEdges(replacement)) {
+        graph_.bringIn(replacement);
+        mesh_.growEdges(edgeCount());
+      }
     for (CandidateIndex replacement : {abd, bcd}) {
       if (isQueued(replacement)) // its heap entry is outdated from now on
         --queued_[queueNumber(states_[replacement].state)];
@@ -177,14 +151,13 @@ void GreedyMesher::Impl::swapNonDelaunayDiagonals() {
     }
     ++statistics_.swapped_pairs;
   }
-  unnumbered_offsets_ = {};
-  unnumbered_ = {};
+  graph_.forgetUnnumbered();
 }
 
 /// Final guarantee: every vertex's triangles form one fan. At a bow-tie the
-/// fan with the most fixed triangles, then the most triangles (ties: the
-/// cheaper one) stays and the others are undone, except fixed triangles; removals can split fans
-/// at neighbouring vertices, so those are checked again. A vertex gets a second fan only when a
+/// fan chosen by the one bow-tie rule (fan_choice.h) stays and the others are
+/// undone, except fixed triangles; removals can split fans at neighbouring
+/// vertices, so those are checked again. A vertex gets a second fan only when a
 /// triangle at it was removed or accepted against the vertex-face incidence rule: only those
 /// vertices are looked at.
 void GreedyMesher::Impl::enforceManifoldVertices() {
@@ -204,22 +177,10 @@ void GreedyMesher::Impl::enforceManifoldVertices() {
     if (mesh_.isSingleFan(v))
       continue;
     const auto fans = mesh_.fansAround(v);
-    std::size_t best = 0;
-    for (std::size_t f = 1; f < fans.size(); ++f) {
-      const std::size_t fixed = fixedCount(fans[f]), best_fixed = fixedCount(fans[best]);
-      const std::size_t preferred = preferredCount(fans[f]),
-                        best_preferred = preferredCount(fans[best]);
-      if (fixed != best_fixed) {
-        if (fixed > best_fixed)
-          best = f;
-      } else if (preferred != best_preferred) {
-        if (preferred > best_preferred)
-          best = f;
-      } else if (fans[f].size() > fans[best].size() ||
-                 (fans[f].size() == fans[best].size() && fanCost(fans[f]) < fanCost(fans[best]))) {
-        best = f;
-      }
-    }
+    const std::size_t best = detail::fanToKeep(fans.size(), [&](std::size_t f) {
+      return detail::FanWeight{fixedCount(fans[f]), preferredCount(fans[f]), fans[f].size(),
+                               fanCost(fans[f])};
+    });
     for (std::size_t f = 0; f < fans.size(); ++f) {
       if (f == best)
         continue;

@@ -25,15 +25,15 @@ MeshedPoints meshPoints(const std::vector<Eigen::Vector3d> &points, const Scaffo
   if (scaffold_built)
     scaffold_built(scaffold);
 
+  meshed.d_med = scaffold.d_med;
+  meshed.local_scale = std::move(scaffold.local_scale); // the greedy does not read it
   const Clock::time_point greedy_start = Clock::now();
-  GreedyMesher mesher(scaffold, points, parameters, deadline);
+  GreedyMesher mesher(std::move(scaffold), points, parameters, deadline);
   mesher.run();
   meshed.triangles = mesher.triangles(with_fixed_triangles);
   meshed.seam_triangles = mesher.seamTriangles();
   meshed.greedy = mesher.statistics();
   meshed.greedy_seconds = secondsSince(greedy_start);
-  meshed.d_med = scaffold.d_med;
-  meshed.local_scale = std::move(scaffold.local_scale);
   return meshed;
 }
 

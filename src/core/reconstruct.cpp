@@ -435,6 +435,7 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
                                        result.candidates_type2 = scaffold.type2;
                                        result.candidates_type3 = scaffold.type3;
                                        result.candidates_oversize = scaffold.oversize;
+                                       result.candidates_degenerate = scaffold.degenerate;
                                        result.initial_oversize = scaffold.preferred_oversize;
                                        result.initial_invalid += scaffold.preferred_degenerate;
                                        result.peak_memory.scaffold = std::max(

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Unit tests of each core stage on configurations whose answers are known by hand.
 #include "core_test_support.h"
+#include "fan_choice.h"
 #include "finish_steps.h"
 
 #include <pcl_ms/costs.h>
@@ -15,6 +16,7 @@
 #include <map>
 #include <set>
 #include <stdexcept>
+#include <utility>
 
 using namespace pcl_ms;
 using pcl_ms_test::expectCleanManifold;
@@ -164,12 +166,12 @@ TEST(Scaffold, EdgeGraphHoldsOnlyTheCandidatesOfPassOne) {
 
   // Pass 2 numbers the edges of the type III candidates it meshes, new
   // edges included, and the mesh stays edge-manifold.
-  GreedyMesher mesher(scaffold, points, Parameters());
-  mesher.run();
   std::set<Triangle> type_three;
   for (const Candidate &candidate : scaffold.candidates)
     if (candidate.type == CandidateType::ambiguous)
       type_three.insert(candidate.vertices);
+  GreedyMesher mesher(std::move(scaffold), points, Parameters());
+  mesher.run();
   std::map<std::pair<VertexIndex, VertexIndex>, int> edge_uses;
   std::size_t meshed_type_three = 0;
   for (Triangle triangle : mesher.triangles()) {
@@ -331,7 +333,7 @@ TEST(Greedy, TetrahedronClosesIntoFourTriangles) {
   MedialScaffold scaffold = buildMedialScaffold(regularTetrahedron(), {});
   const std::vector<Eigen::Vector3d> points = regularTetrahedron();
   Parameters parameters;
-  GreedyMesher mesher(scaffold, points, parameters);
+  GreedyMesher mesher(std::move(scaffold), points, parameters);
   mesher.run();
   EXPECT_EQ(mesher.triangles().size(), 4u);
   EXPECT_EQ(mesher.statistics().pass1.accepted, 4u);
@@ -366,6 +368,42 @@ TEST(Greedy, SphereSamplingIsAClosedGenusZeroSurface) {
   EXPECT_TRUE(report.orientable);
   EXPECT_EQ(report.inconsistently_oriented_edges, 0u);
   EXPECT_EQ(result.triangles.size(), 2u * 400 - 4);
+}
+
+// ---- bow-ties ------------------------------------------------------------------------
+
+TEST(BowTies, OneRuleRanksFixedThenPreferredThenSizeThenCost) {
+  using detail::FanWeight;
+  const auto keep = [](const std::vector<FanWeight> &fans) {
+    return detail::fanToKeep(fans.size(), [&](std::size_t f) { return fans[f]; });
+  };
+  // fixed, preferred, size, cost
+  EXPECT_EQ(keep({{0, 0, 9, 0.0}, {1, 0, 1, 5.0}}), 1u);
+  EXPECT_EQ(keep({{0, 0, 9, 0.0}, {0, 2, 1, 5.0}, {0, 1, 9, 0.0}}), 1u);
+  EXPECT_EQ(keep({{0, 0, 2, 0.0}, {0, 0, 3, 9.0}}), 1u);
+  EXPECT_EQ(keep({{0, 0, 3, 2.0}, {0, 0, 3, 1.0}, {0, 0, 3, 1.5}}), 1u);
+  EXPECT_EQ(keep({{0, 0, 3, 1.0}, {0, 0, 3, 1.0}}), 0u); // full tie: the first
+}
+
+TEST(BowTies, SplitKeepsTheLargerFanAndRechecksTheCornersOfWhatItRemoves) {
+  // Vertex 0 has a fan of three triangles and one of two; the small fan's
+  // removal leaves vertex 7 between two fans of its own, the larger of
+  // which (7, 8, 9), (7, 9, 10) stays.
+  std::vector<Triangle> triangles = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4},  {0, 5, 6},
+                                     {0, 6, 7}, {7, 8, 9}, {7, 9, 10}, {6, 7, 11}};
+  std::vector<bool> touched(12, false);
+  touched[0] = true;
+  const std::size_t removed = splitBowTies(triangles, 12, touched);
+  const std::vector<Triangle> expected = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {7, 8, 9}, {7, 9, 10}};
+  EXPECT_EQ(triangles, expected);
+  EXPECT_EQ(removed, 3u);
+
+  // Equal fans: the first (by lowest triangle) stays.
+  std::vector<Triangle> pair = {{0, 1, 2}, {0, 3, 4}};
+  std::vector<bool> at_zero(5, false);
+  at_zero[0] = true;
+  EXPECT_EQ(splitBowTies(pair, 5, at_zero), 1u);
+  EXPECT_EQ(pair, (std::vector<Triangle>{{0, 1, 2}}));
 }
 
 // ---- finish --------------------------------------------------------------------------

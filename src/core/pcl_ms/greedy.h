@@ -29,10 +29,12 @@ struct GreedyStatistics {
 
 class GreedyMesher {
 public:
-  /// The scaffold must outlive the mesher. It is not const: the type III
-  /// candidates that reach pass 2 get their edges numbered in it.
-  /// With a deadline, run() throws TimeLimitExceeded once it has passed.
-  GreedyMesher(MedialScaffold &scaffold, const std::vector<Eigen::Vector3d> &points,
+  /// The mesher takes the scaffold over: its candidate graph
+  /// (candidate_graph.h) owns it and numbers the edges of the type III
+  /// candidates that reach pass 2. The points and parameters must outlive
+  /// the mesher. With a deadline, run() throws TimeLimitExceeded once it
+  /// has passed.
+  GreedyMesher(MedialScaffold &&scaffold, const std::vector<Eigen::Vector3d> &points,
                const Parameters &parameters, const Deadline *deadline = nullptr);
   ~GreedyMesher();
   GreedyMesher(const GreedyMesher &) = delete;

@@ -9,12 +9,9 @@
 
 #include <array>
 #include <cstdint>
-#include <limits>
 #include <vector>
 
 namespace pcl_ms {
-
-constexpr CandidateIndex no_candidate = std::numeric_limits<CandidateIndex>::max();
 
 /// Groups items 0..count-1 into connected sets by union-find; joins(join)
 /// calls join(i, j) for every pair known to be connected. Groups come in

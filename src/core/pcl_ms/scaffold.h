@@ -43,6 +43,8 @@ struct Candidate {
 
 /// The edge slot of a candidate whose edges are not numbered yet.
 constexpr EdgeIndex no_edge = std::numeric_limits<EdgeIndex>::max();
+/// "No such candidate" (never a valid index).
+constexpr CandidateIndex no_candidate = std::numeric_limits<CandidateIndex>::max();
 
 /// Candidates below d_max, and which candidates share each edge (CSR).
 struct MedialScaffold {
@@ -50,7 +52,8 @@ struct MedialScaffold {
   /// The edge graph holds the candidates pass 1 looks at: types I and II and
   /// the fixed and preferred ones, ascending on each edge. The other type III
   /// candidates, the majority but rarely kept, wait outside it with edges
-  /// no_edge: GreedyMesher numbers those that reach pass 2.
+  /// no_edge: the greedy's candidate graph (candidate_graph.h) numbers
+  /// those that reach pass 2.
   std::vector<std::uint32_t> edge_offsets; // edges + 1 entries
   std::vector<CandidateIndex> edge_candidates;
   /// Edge ids by end points: edge_vertex_offsets[a] is the id of a's first
