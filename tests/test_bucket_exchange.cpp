@@ -8,7 +8,9 @@
 #include <pcl_ms/reconstruct.h>
 
 #include <algorithm>
+#include <cmath>
 #include <condition_variable>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -201,6 +203,35 @@ TEST_F(BucketExchange, AFarmGivesTheOneProcessMesh) {
   EXPECT_GE(farm.units, expected.buckets + 1);
   EXPECT_LE(farm.units, expected.buckets + expected.seam_zones);
   EXPECT_LE(farm.most_in_flight, 3u);
+}
+
+/// A farm that spoils the caller's cloud as soon as the core says it has
+/// its own copy (what the MPI tool does to free rank 0's memory): the core
+/// must not read the cloud after that.
+class SpoilingFarm : public BatchFarm {
+public:
+  SpoilingFarm(const pcl_ms::Parameters &parameters, pcl::PointCloud<pcl::PointXYZ> &cloud)
+      : BatchFarm(parameters), cloud_(cloud) {}
+  void pointsPrepared() override {
+    ++calls;
+    for (pcl::PointXYZ &point : cloud_)
+      point.x = point.y = point.z = std::numeric_limits<float>::quiet_NaN();
+  }
+  int calls = 0;
+
+private:
+  pcl::PointCloud<pcl::PointXYZ> &cloud_;
+};
+
+TEST_F(BucketExchange, TheCloudIsNotReadAfterThePointsArePrepared) {
+  pcl::PointCloud<pcl::PointXYZ> spoilt = *cloud;
+  SpoilingFarm farm(parameters, spoilt);
+  const pcl_ms::Result result = pcl_ms::reconstruct(viewOf(spoilt), parameters, farm);
+  EXPECT_EQ(farm.calls, 1);
+  EXPECT_TRUE(std::isnan(spoilt[0].x));
+  EXPECT_EQ(result.triangles, reference.triangles);
+  EXPECT_EQ(result.boundary_loops, reference.boundary_loops);
+  EXPECT_EQ(result.invalid_points, 0u);
 }
 
 TEST(BucketOwner, LeavesAreSharedInContiguousRanges) {
