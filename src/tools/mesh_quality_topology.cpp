@@ -4,6 +4,7 @@
 // MeshTopologyReport (components, boundary loops, non-manifold edges and
 // vertices, orientability, angles), from a half-edge table built by sorting,
 // union-find for components, fans and orientation.
+#include <pcl_ms/disjoint_sets.h>
 #include <pcl_ms/mesh_quality.h>
 
 #include "mesh_triangles.h"
@@ -30,87 +31,8 @@ constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
 // ---------------------------------------------------------------------------
 // Small helpers
 
-/// Union-find with path halving; the smaller index becomes the root so that
-/// roots, and everything numbered by them, do not depend on the union order.
-class DisjointSets {
-public:
-  explicit DisjointSets(std::size_t size = 0) { reset(size); }
-
-  void reset(std::size_t size) {
-    parent_.resize(size);
-    std::iota(parent_.begin(), parent_.end(), std::size_t{0});
-  }
-
-  std::size_t find(std::size_t element) {
-    while (parent_[element] != element) {
-      parent_[element] = parent_[parent_[element]];
-      element = parent_[element];
-    }
-    return element;
-  }
-
-  void unite(std::size_t a, std::size_t b) {
-    a = find(a);
-    b = find(b);
-    if (a == b)
-      return;
-    if (a < b)
-      std::swap(a, b);
-    parent_[a] = b;
-  }
-
-private:
-  std::vector<std::size_t> parent_;
-};
-
-/// Union-find that also stores, per element, whether its orientation is
-/// flipped relative to its root; used to 2-colour triangles by orientation.
-class ParityDisjointSets {
-public:
-  explicit ParityDisjointSets(std::size_t size) : parent_(size), flipped_(size, 0), size_(size, 1) {
-    std::iota(parent_.begin(), parent_.end(), std::size_t{0});
-  }
-
-  /// Records that a and b have opposite orientations (differ) or equal ones;
-  /// returns false when that contradicts what was recorded before.
-  bool relate(std::size_t a, std::size_t b, bool differ) {
-    const auto [root_a, parity_a] = find(a);
-    const auto [root_b, parity_b] = find(b);
-    if (root_a == root_b)
-      return (parity_a != parity_b) == differ;
-    const auto [big, small] =
-        size_[root_a] >= size_[root_b] ? std::pair(root_a, root_b) : std::pair(root_b, root_a);
-    parent_[small] = big;
-    flipped_[small] = static_cast<char>(parity_a ^ parity_b ^ differ);
-    size_[big] += size_[small];
-    return true;
-  }
-
-private:
-  std::pair<std::size_t, bool> find(std::size_t element) {
-    std::size_t root = element;
-    bool parity = false;
-    while (parent_[root] != root) {
-      parity ^= flipped_[root] != 0;
-      root = parent_[root];
-    }
-    // Compress the path, keeping each node's parity relative to the root.
-    bool node_parity = parity;
-    for (std::size_t node = element; parent_[node] != node;) {
-      const std::size_t next = parent_[node];
-      const bool next_parity = node_parity ^ (flipped_[node] != 0);
-      parent_[node] = root;
-      flipped_[node] = static_cast<char>(node_parity);
-      node = next;
-      node_parity = next_parity;
-    }
-    return {root, parity};
-  }
-
-  std::vector<std::size_t> parent_;
-  std::vector<char> flipped_;
-  std::vector<std::size_t> size_;
-};
+using pcl_ms::detail::DisjointSets;
+using pcl_ms::detail::ParityForest;
 
 // ---------------------------------------------------------------------------
 // Topology
@@ -166,7 +88,7 @@ EdgeTable buildEdgeTable(const std::vector<Triangle> &triangles,
 void analyzeOrientation(const std::vector<Triangle> &triangles, const EdgeTable &edges,
                         const std::vector<std::size_t> &component_of_triangle,
                         std::size_t component_count, MeshTopologyReport &report) {
-  ParityDisjointSets orientation(triangles.size());
+  ParityForest orientation(triangles.size());
   std::vector<char> component_broken(component_count, 0);
   for (std::size_t e = 0; e < edges.size(); ++e) {
     if (edges.faceCount(e) != 2)
@@ -180,7 +102,9 @@ void analyzeOrientation(const std::vector<Triangle> &triangles, const EdgeTable 
       ++report.inconsistently_oriented_edges;
     // Consistency needs one of the two triangles flipped exactly when both run
     // the edge the same way.
-    if (!orientation.relate(first_triangle, second_triangle, same_direction))
+    if (orientation.join(static_cast<std::uint32_t>(first_triangle),
+                         static_cast<std::uint32_t>(second_triangle),
+                         same_direction) == ParityForest::Join::conflict)
       component_broken[component_of_triangle[first_triangle]] = 1;
   }
   report.non_orientable_components =
@@ -231,7 +155,6 @@ void analyzeVertexFans(const std::vector<Triangle> &triangles, std::size_t verte
   std::vector<EdgeAtVertex> incident_edges;
   std::vector<BoundaryAtVertex> boundary;
   std::vector<BoundaryAtVertex> unpaired;
-  DisjointSets fans;
 
   for (std::size_t vertex = 0; vertex < vertex_count; ++vertex) {
     const std::size_t begin = corners_begin[vertex], end = corners_begin[vertex + 1];
@@ -249,7 +172,7 @@ void analyzeVertexFans(const std::vector<Triangle> &triangles, std::size_t verte
     std::sort(incident_edges.begin(), incident_edges.end());
 
     // Triangles form one fan when linked through edges with two triangles.
-    fans.reset(end - begin);
+    DisjointSets fans(end - begin);
     bool on_non_manifold_edge = false;
     for (std::size_t k = 0; k < incident_edges.size();) {
       std::size_t run_end = k + 1;
@@ -260,12 +183,12 @@ void analyzeVertexFans(const std::vector<Triangle> &triangles, std::size_t verte
       if (face_count > 2)
         on_non_manifold_edge = true;
       else if (face_count == 2)
-        fans.unite(incident_edges[k].local_triangle, incident_edges[k + 1].local_triangle);
+        fans.union_set(incident_edges[k].local_triangle, incident_edges[k + 1].local_triangle);
       k = run_end;
     }
     std::size_t fan_count = 0;
     for (std::size_t local = 0; local < end - begin; ++local)
-      if (fans.find(local) == local)
+      if (fans.find_set(local) == local)
         ++fan_count;
     if (!on_non_manifold_edge && fan_count > 1)
       ++report.non_manifold_vertices;
@@ -275,7 +198,7 @@ void analyzeVertexFans(const std::vector<Triangle> &triangles, std::size_t verte
     boundary.clear();
     for (const EdgeAtVertex &incident : incident_edges)
       if (edges.faceCount(incident.edge) == 1)
-        boundary.push_back({fans.find(incident.local_triangle),
+        boundary.push_back({fans.find_set(incident.local_triangle),
                             edges.otherEnd(incident.edge, static_cast<VertexIndex>(vertex)),
                             incident.edge});
     if (boundary.empty())
@@ -287,7 +210,7 @@ void analyzeVertexFans(const std::vector<Triangle> &triangles, std::size_t verte
       while (run_end < boundary.size() && boundary[run_end].fan == boundary[k].fan)
         ++run_end;
       if (run_end - k == 2)
-        curves.unite(boundary[k].edge, boundary[k + 1].edge);
+        curves.union_set(boundary[k].edge, boundary[k + 1].edge);
       else
         unpaired.insert(unpaired.end(), boundary.begin() + static_cast<std::ptrdiff_t>(k),
                         boundary.begin() + static_cast<std::ptrdiff_t>(run_end));
@@ -298,7 +221,7 @@ void analyzeVertexFans(const std::vector<Triangle> &triangles, std::size_t verte
       return std::tie(a.far_vertex, a.edge) < std::tie(b.far_vertex, b.edge);
     });
     for (std::size_t k = 0; k + 1 < unpaired.size(); k += 2)
-      curves.unite(unpaired[k].edge, unpaired[k + 1].edge);
+      curves.union_set(unpaired[k].edge, unpaired[k + 1].edge);
     if (unpaired.size() % 2 == 1)
       has_loose_end[unpaired.back().edge] = 1;
   }
@@ -308,7 +231,7 @@ void analyzeVertexFans(const std::vector<Triangle> &triangles, std::size_t verte
   for (std::size_t e = 0; e < edges.size(); ++e) {
     if (edges.faceCount(e) != 1)
       continue;
-    const std::size_t root = curves.find(e);
+    const std::size_t root = curves.find_set(e);
     ++curve_length[root];
     if (has_loose_end[e])
       curve_open[root] = 1;
@@ -416,8 +339,8 @@ MeshTopologyReport analyzeMesh(const std::vector<Eigen::Vector3d> &vertices,
   DisjointSets components(triangles.size());
   for (std::size_t e = 0; e < edges.size(); ++e)
     for (std::size_t k = edges.halfedges_begin[e] + 1; k < edges.halfedges_begin[e + 1]; ++k)
-      components.unite(edges.sorted_halfedges[edges.halfedges_begin[e]] / 3,
-                       edges.sorted_halfedges[k] / 3);
+      components.union_set(edges.sorted_halfedges[edges.halfedges_begin[e]] / 3,
+                           edges.sorted_halfedges[k] / 3);
   std::vector<std::size_t> component_of_triangle(triangles.size(), kNone);
   std::vector<std::size_t> component_of_root(triangles.size(), kNone);
   std::vector<char> vertex_in_topology(vertices.size(), 0);
@@ -428,7 +351,7 @@ MeshTopologyReport analyzeMesh(const std::vector<Eigen::Vector3d> &vertices,
     ++topology_triangles;
     for (VertexIndex vertex : triangles[t])
       vertex_in_topology[vertex] = 1;
-    std::size_t &component = component_of_root[components.find(t)];
+    std::size_t &component = component_of_root[components.find_set(t)];
     if (component == kNone)
       component = report.components++;
     component_of_triangle[t] = component;

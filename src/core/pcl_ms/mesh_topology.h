@@ -3,6 +3,7 @@
 // per-edge and per-vertex counts the manifold rules ask about in O(1).
 #pragma once
 
+#include <pcl_ms/disjoint_sets.h>
 #include <pcl_ms/scaffold.h>
 
 #include <boost/container/small_vector.hpp>
@@ -19,19 +20,12 @@ namespace pcl_ms {
 /// triangles around a vertex into fans.
 template <typename Joins>
 std::vector<std::vector<std::size_t>> connectedGroups(std::size_t count, const Joins &joins) {
-  std::vector<std::size_t> parent(count);
-  for (std::size_t i = 0; i < count; ++i)
-    parent[i] = i;
-  auto find = [&](std::size_t i) {
-    while (parent[i] != i)
-      i = parent[i] = parent[parent[i]];
-    return i;
-  };
-  joins([&](std::size_t i, std::size_t j) { parent[find(i)] = find(j); });
+  detail::DisjointSets sets(count);
+  joins([&](std::size_t i, std::size_t j) { sets.union_set(i, j); });
   std::vector<std::vector<std::size_t>> groups;
   std::vector<std::size_t> group_of_root(count, count);
   for (std::size_t i = 0; i < count; ++i) {
-    const std::size_t root = find(i);
+    const std::size_t root = sets.find_set(i);
     if (group_of_root[root] == count) {
       group_of_root[root] = groups.size();
       groups.emplace_back();
