@@ -32,6 +32,8 @@ void MeshTopology::add(CandidateIndex t) {
   assert(t < in_mesh_.size() && !in_mesh_[t]);
   const Candidate &candidate = scaffold_.candidates[t];
   for (int k = 0; k < 3; ++k) {
+    // Edges numbered after construction must have been made room for.
+    assert(candidate.edges[k] < edge_slots_.size() && "growEdges after the graph numbered edges");
     auto &slots = edge_slots_[candidate.edges[k]];
     // A removal may leave an edge's one triangle in either slot.
     assert((slots[0] == no_candidate || slots[1] == no_candidate) &&
