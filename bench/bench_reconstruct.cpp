@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // bench_reconstruct: times pcl_ms::reconstruct against CGAL's advancing-front
 // surface reconstruction (AFSR) and a bare 3-D Delaunay triangulation on the
-// bunny vertices and on uniform samplings of the bunny reference surface.
-// Every method runs single-threaded in its own forked child so that its peak
-// resident memory (VmHWM) is not mixed with the others'.
+// bunny vertices, on uniform samplings of the bunny reference surface and on
+// any other clouds given. Every method runs in its own forked child so that
+// its peak resident memory (VmHWM) is not mixed with the others'; pcl_ms and
+// the Delaunay triangulation on one thread and, if asked, on more.
 #include "child_process.h"
 #include "mesh_report.h"
 #include "surface_sampling.h"
@@ -14,6 +15,9 @@
 #include <CGAL/Advancing_front_surface_reconstruction.h>
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Spatial_lock_grid_3.h>
+
+#include <tbb/task_arena.h>
 
 #include <pcl/console/parse.h>
 #include <pcl/console/print.h>
@@ -98,12 +102,14 @@ Measurement runNothing(const Input &) {
   return measurement;
 }
 
-Measurement runPclMs(const Input &input) {
+Measurement runPclMs(const Input &input, int threads, bool one_piece) {
   pcl_ms::PointView view;
   view.xyz = input.xyz.data();
   view.size = input.size();
   pcl_ms::Parameters parameters;
-  parameters.num_threads = 1;
+  parameters.num_threads = threads;
+  if (one_piece)
+    parameters.bucket_points = input.size();
   const Stopwatch stopwatch;
   const pcl_ms::Result result = pcl_ms::reconstruct(view, parameters);
   Measurement measurement;
@@ -140,6 +146,40 @@ Measurement runDelaunay(const Input &input) {
   return measurement;
 }
 
+/// CGAL's non-blocking lock grid: a thread that meets a locked cell gives its
+/// point back and retries it later. The default (priority blocking) waits,
+/// and on a busy machine the lock holder is often descheduled.
+using LockGrid = CGAL::Spatial_lock_grid_3<CGAL::Tag_non_blocking>;
+/// Cells per axis of the lock grid: the value of CGAL's example.
+constexpr int lock_grid_cells_per_axis = 50;
+
+/// The bare triangulation on several threads, as CGAL's documentation sets
+/// it up: concurrent containers, a lock grid over the bounding box, range
+/// insertion inside an arena of `threads` threads.
+Measurement runParallelDelaunay(const Input &input, int threads) {
+  using DataStructure =
+      CGAL::Triangulation_data_structure_3<CGAL::Triangulation_vertex_base_3<Kernel>,
+                                           CGAL::Delaunay_triangulation_cell_base_3<Kernel>,
+                                           CGAL::Parallel_tag>;
+  using Triangulation =
+      CGAL::Delaunay_triangulation_3<Kernel, DataStructure, CGAL::Default, LockGrid>;
+  const std::vector<CgalPoint> points = toCgalPoints(input);
+  CGAL::Bbox_3 box;
+  for (const CgalPoint &point : points)
+    box += point.bbox();
+  Measurement measurement;
+  tbb::task_arena arena(threads);
+  const Stopwatch stopwatch;
+  Triangulation::Lock_data_structure lock(box, lock_grid_cells_per_axis);
+  arena.execute([&] {
+    Triangulation triangulation(points.begin(), points.end(), &lock);
+    stopwatch.stop(measurement);
+    measurement.triangles = triangulation.number_of_finite_facets();
+  });
+  measurement.ok = true;
+  return measurement;
+}
+
 /// Runs `method` in a forked child and collects its result and peak memory.
 Run runInChild(const std::string &name, const std::function<Measurement(const Input &)> &method,
                const Input &input) {
@@ -160,7 +200,9 @@ Run runInChild(const std::string &name, const std::function<Measurement(const In
 
 // --- Inputs -----------------------------------------------------------------
 
-bool loadBunnyVertices(const std::string &path, Input &input, std::string &error) {
+/// The finite points of a cloud file: AFSR and the Delaunay triangulation
+/// take no NaN, and pcl_ms would leave them out anyway.
+bool loadCloud(const std::string &path, const std::string &name, Input &input, std::string &error) {
   pcl::PCLPointCloud2 cloud;
   if (!pcl_ms::loadPointCloud(path, cloud, error))
     return false;
@@ -169,12 +211,20 @@ bool loadBunnyVertices(const std::string &path, Input &input, std::string &error
   for (std::size_t f = 0; f < cloud.fields.size(); ++f)
     if (cloud.fields[f].name == "x")
       x = static_cast<int>(f);
-  input.name = "bunny vertices (" + path + ")";
-  input.xyz.resize(3 * count);
+  input.name = name + " (" + path + ")";
+  input.xyz.clear();
+  input.xyz.reserve(3 * count);
   // loadPointCloud guarantees float32 x, y, z; PCL stores them consecutively.
-  for (std::size_t i = 0; i < count; ++i)
-    std::memcpy(&input.xyz[3 * i], &cloud.data[i * cloud.point_step + cloud.fields[x].offset],
-                3 * sizeof(float));
+  for (std::size_t i = 0; i < count; ++i) {
+    float point[3];
+    std::memcpy(point, &cloud.data[i * cloud.point_step + cloud.fields[x].offset], sizeof point);
+    if (std::isfinite(point[0]) && std::isfinite(point[1]) && std::isfinite(point[2]))
+      input.xyz.insert(input.xyz.end(), point, point + 3);
+  }
+  if (input.size() < 4) {
+    error = path + ": fewer than 4 finite points";
+    return false;
+  }
   return true;
 }
 
@@ -202,18 +252,20 @@ const Run *findRun(const std::vector<Run> &runs, const std::string &method) {
   return nullptr;
 }
 
-void printRatio(const std::vector<Run> &runs, const std::string &other, double baseline_mb) {
-  const Run *ours = findRun(runs, "pcl_ms");
+bool isPclMs(const std::string &method) { return method.rfind("pcl_ms", 0) == 0; }
+
+void printRatio(const Run &ours, const std::vector<Run> &runs, const std::string &other,
+                double baseline_mb) {
   const Run *theirs = findRun(runs, other);
-  if (!ours || !theirs)
+  if (!ours.measurement.ok || !theirs)
     return;
-  const double our_extra = ours->peak_mb - baseline_mb;
+  const double our_extra = ours.peak_mb - baseline_mb;
   const double their_extra = theirs->peak_mb - baseline_mb;
   const auto ratio = [](double a, double b) { return a / std::max(b, 1e-9); };
-  std::printf("  pcl_ms / %-12s time %6.2fx (cpu %5.2fx)   peak memory %5.2fx", other.c_str(),
-              ratio(ours->measurement.seconds, theirs->measurement.seconds),
-              ratio(ours->measurement.cpu_seconds, theirs->measurement.cpu_seconds),
-              ratio(ours->peak_mb, theirs->peak_mb));
+  std::printf("  %-16s / %-21s time %6.2fx (cpu %5.2fx)   peak memory %5.2fx", ours.method.c_str(),
+              other.c_str(), ratio(ours.measurement.seconds, theirs->measurement.seconds),
+              ratio(ours.measurement.cpu_seconds, theirs->measurement.cpu_seconds),
+              ratio(ours.peak_mb, theirs->peak_mb));
   if (their_extra > 0.5)
     std::printf("   above input %5.2fx", our_extra / their_extra);
   std::printf("\n");
@@ -221,37 +273,55 @@ void printRatio(const std::vector<Run> &runs, const std::string &other, double b
 
 void printTable(const Input &input, const std::vector<Run> &runs, double baseline_mb) {
   std::printf("\n== %s: %s points ==\n", input.name.c_str(), withThousands(input.size()).c_str());
-  std::printf("  %-14s %10s %10s %11s %12s %12s\n", "method", "time [s]", "cpu [s]", "peak [MB]",
+  std::printf("  %-22s %10s %10s %11s %12s %12s\n", "method", "time [s]", "cpu [s]", "peak [MB]",
               "above input", "triangles");
   for (const Run &run : runs) {
     if (!run.measurement.ok) {
-      std::printf("  %-14s failed: %s\n", run.method.c_str(), run.measurement.message);
+      std::printf("  %-22s failed: %s\n", run.method.c_str(), run.measurement.message);
       continue;
     }
     if (run.method == "input only") {
-      std::printf("  %-14s %10s %10s %11.1f %12s %12s\n", run.method.c_str(), "-", "-", run.peak_mb,
+      std::printf("  %-22s %10s %10s %11.1f %12s %12s\n", run.method.c_str(), "-", "-", run.peak_mb,
                   "-", "-");
       continue;
     }
-    std::printf("  %-14s %10.3f %10.3f %11.1f %12.1f %12s%s\n", run.method.c_str(),
+    std::printf("  %-22s %10.3f %10.3f %11.1f %12.1f %12s%s\n", run.method.c_str(),
                 run.measurement.seconds, run.measurement.cpu_seconds, run.peak_mb,
                 run.peak_mb - baseline_mb, withThousands(run.measurement.triangles).c_str(),
-                run.method == "Delaunay 3D" ? " (all facets)" : "");
+                run.method.rfind("Delaunay 3D", 0) == 0 ? " (all facets)" : "");
   }
-  if (const Run *ours = findRun(runs, "pcl_ms")) {
-    const pcl_ms::StageTimings &stages = ours->measurement.stages;
-    std::printf("  pcl_ms stages [s]: prepare %.3f  delaunay %.3f  scaffold %.3f  greedy %.3f  "
+  for (const Run &ours : runs) {
+    if (!isPclMs(ours.method) || !ours.measurement.ok)
+      continue;
+    const pcl_ms::StageTimings &stages = ours.measurement.stages;
+    std::printf("  %s stages [s]: prepare %.3f  delaunay %.3f  scaffold %.3f  greedy %.3f  "
                 "finish %.3f  total %.3f\n",
-                stages.prepare, stages.delaunay, stages.scaffold, stages.greedy, stages.finish,
-                stages.total);
-    const pcl_ms::StagePeakMemory &memory = ours->measurement.stage_memory;
+                ours.method.c_str(), stages.prepare, stages.delaunay, stages.scaffold,
+                stages.greedy, stages.finish, stages.total);
+    const pcl_ms::StagePeakMemory &memory = ours.measurement.stage_memory;
     const double mb = 1024.0 * 1024.0;
-    std::printf("  pcl_ms process peak after stage [MB]: prepare %.1f  delaunay+scaffold %.1f  "
+    std::printf("  %s process peak after stage [MB]: prepare %.1f  delaunay+scaffold %.1f  "
                 "greedy %.1f  finish %.1f\n",
-                memory.prepare / mb, memory.scaffold / mb, memory.greedy / mb, memory.finish / mb);
+                ours.method.c_str(), memory.prepare / mb, memory.scaffold / mb, memory.greedy / mb,
+                memory.finish / mb);
   }
-  printRatio(runs, "AFSR", baseline_mb);
-  printRatio(runs, "Delaunay 3D", baseline_mb);
+  for (const Run &ours : runs) {
+    if (!isPclMs(ours.method))
+      continue;
+    // Against the peer, and against the floor on as many threads: the whole
+    // run, then its own triangulation alone.
+    const std::string threads = ours.method.substr(std::string("pcl_ms").size());
+    printRatio(ours, runs, "AFSR", baseline_mb);
+    printRatio(ours, runs, "Delaunay 3D" + threads, baseline_mb);
+    if (const Run *bare = findRun(runs, "Delaunay 3D" + threads))
+      if (ours.measurement.ok && bare->measurement.seconds > 0)
+        std::printf("  %-16s delaunay stage / %s %.2fx\n", ours.method.c_str(),
+                    bare->method.c_str(),
+                    ours.measurement.stages.delaunay / bare->measurement.seconds);
+  }
+  // The peer against the floor, for scale.
+  if (const Run *afsr = findRun(runs, "AFSR"))
+    printRatio(*afsr, runs, "Delaunay 3D", baseline_mb);
   std::fflush(stdout);
 }
 
@@ -259,7 +329,7 @@ void writeCsvRows(std::ofstream &csv, const Input &input, const std::vector<Run>
                   double baseline_mb) {
   for (const Run &run : runs) {
     const Measurement &m = run.measurement;
-    const bool ours = run.method == "pcl_ms";
+    const bool ours = isPclMs(run.method);
     csv << '"' << input.name << "\"," << input.size() << ',' << run.method << ','
         << (m.ok ? "ok" : "failed") << ',' << m.seconds << ',' << m.cpu_seconds << ','
         << run.peak_mb << ',' << run.peak_mb - baseline_mb << ',' << m.triangles;
@@ -277,12 +347,16 @@ void writeCsvRows(std::ofstream &csv, const Input &input, const std::vector<Run>
 
 void printHelp(const char *program) {
   std::printf("Times pcl_ms::reconstruct, CGAL's advancing-front reconstruction (AFSR) and a bare\n"
-              "CGAL 3-D Delaunay triangulation, single-threaded, each in its own child process.\n\n"
+              "CGAL 3-D Delaunay triangulation, each in its own child process.\n\n"
               "Usage: %s [options]\n\n"
               "  -data DIR        sample data directory with bunny.pcd (default: data)\n"
               "  -mesh PATH       reference mesh to sample (default: DIR/bun_zipper.ply)\n"
+              "  -clouds F,F,...  more clouds to run (.pcd, .ply, ...; their finite points)\n"
               "  -sizes N,N,...   surface sample sizes, or none (default: 100000,300000,1000000)\n"
+              "  -threads N,N,... thread counts for pcl_ms and the bare Delaunay (default: 1)\n"
+              "  -one_piece       pcl_ms without buckets, whatever the size\n"
               "  -skip_afsr       do not run AFSR (slow on large inputs)\n"
+              "  -afsr_up_to N    run AFSR only on inputs of at most N points (default: all)\n"
               "  -repeat N        run the methods N times in turn and keep each one's fastest run\n"
               "                   (default 1; machines whose speed drifts need 3 or more)\n"
               "  -csv FILE        also write every measurement to FILE\n"
@@ -290,7 +364,7 @@ void printHelp(const char *program) {
               program);
 }
 
-bool parseSizes(const std::string &text, std::vector<std::size_t> &sizes) {
+bool parseSizes(const std::string &text, std::vector<std::size_t> &sizes, std::size_t minimum = 4) {
   sizes.clear();
   if (text == "none")
     return true;
@@ -301,7 +375,7 @@ bool parseSizes(const std::string &text, std::vector<std::size_t> &sizes) {
       end = text.size();
     std::size_t value = 0;
     const auto [last, code] = std::from_chars(text.data() + start, text.data() + end, value);
-    if (code != std::errc() || last != text.data() + end || value < 4)
+    if (code != std::errc() || last != text.data() + end || value < minimum)
       return false;
     sizes.push_back(value);
     start = end + 1;
@@ -326,10 +400,11 @@ int main(int argc, char **argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
     if (argument == "-data" || argument == "-mesh" || argument == "-sizes" || argument == "-csv" ||
-        argument == "-repeat") {
+        argument == "-repeat" || argument == "-threads" || argument == "-clouds" ||
+        argument == "-afsr_up_to") {
       if (++i >= argc)
         return fail(argument + " needs a value");
-    } else if (argument != "-skip_afsr") {
+    } else if (argument != "-skip_afsr" && argument != "-one_piece") {
       return fail("unknown argument '" + argument + "' (see -h)");
     }
   }
@@ -339,7 +414,31 @@ int main(int argc, char **argv) {
   pcl::console::parse_argument(argc, argv, "-mesh", mesh_path);
   pcl::console::parse_argument(argc, argv, "-sizes", sizes_text);
   pcl::console::parse_argument(argc, argv, "-csv", csv_path);
+  std::string threads_text = "1", clouds_text;
+  pcl::console::parse_argument(argc, argv, "-threads", threads_text);
+  pcl::console::parse_argument(argc, argv, "-clouds", clouds_text);
   const bool skip_afsr = pcl::console::find_switch(argc, argv, "-skip_afsr");
+  const bool one_piece = pcl::console::find_switch(argc, argv, "-one_piece");
+  std::vector<std::size_t> afsr_limit;
+  if (const int at = pcl::console::find_argument(argc, argv, "-afsr_up_to");
+      at >= 0 && (!parseSizes(argv[at + 1], afsr_limit, 0) || afsr_limit.size() != 1))
+    return fail("-afsr_up_to: expected a number of points");
+  std::vector<std::size_t> thread_counts;
+  if (!parseSizes(threads_text, thread_counts, 1) || thread_counts.empty())
+    return fail("-threads: expected a comma-separated list of numbers >= 1, got '" + threads_text +
+                "'");
+  std::vector<std::string> cloud_paths;
+  for (std::size_t start = 0; !clouds_text.empty() && start <= clouds_text.size();) {
+    std::size_t end = clouds_text.find(',', start);
+    if (end == std::string::npos)
+      end = clouds_text.size();
+    cloud_paths.push_back(clouds_text.substr(start, end - start));
+    start = end + 1;
+  }
+  // A missing file fails before anything is loaded.
+  for (const std::string &path : cloud_paths)
+    if (!std::ifstream(path))
+      return fail("-clouds: cannot read '" + path + "'");
   int repeat = 1;
   pcl::console::parse_argument(argc, argv, "-repeat", repeat);
   if (repeat < 1 || repeat > 100)
@@ -362,31 +461,55 @@ int main(int argc, char **argv) {
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
   std::string error;
   Input bunny;
-  if (!loadBunnyVertices(data_dir + "/bunny.pcd", bunny, error))
+  if (!loadCloud(data_dir + "/bunny.pcd", "bunny vertices", bunny, error))
     return fail(error);
   std::vector<Eigen::Vector3d> vertices;
   std::vector<pcl_ms::Triangle> triangles;
   if (!sizes.empty() && !pcl_ms::loadMesh(mesh_path, vertices, triangles, error))
     return fail(error);
+  // Fail before the first run, not after the bunny's: read every cloud once
+  // (a file that opens may still not parse or hold too few finite points).
+  for (const std::string &path : cloud_paths) {
+    Input probe;
+    if (!loadCloud(path, "cloud", probe, error))
+      return fail("-clouds: " + error);
+  }
 
-  std::printf("bench_reconstruct: single-threaded; each method in a forked child, peak = its "
+  std::printf("bench_reconstruct: threads %s%s; each method in a forked child, peak = its "
               "VmHWM.\n'above input' subtracts the peak of a child that only holds the "
-              "input. For pcl_ms, the process peak after each stage is printed too.\n");
+              "input. For pcl_ms, the process peak after each stage is printed too.\n",
+              threads_text.c_str(), one_piece ? ", pcl_ms in one piece" : "");
   if (repeat > 1)
     std::printf("Each method ran %d times, in turn with the others; its fastest run is shown.\n",
                 repeat);
-  for (std::size_t i = 0; i <= sizes.size(); ++i) {
-    // Sample each size only when its turn comes, so the parent stays small.
-    Input sampled;
-    if (i > 0)
-      sampled = sampleSurface(vertices, triangles, sizes[i - 1]);
-    const Input &input = i == 0 ? bunny : sampled;
+  const std::size_t input_count = 1 + cloud_paths.size() + sizes.size();
+  for (std::size_t i = 0; i < input_count; ++i) {
+    // Load or sample each input only when its turn comes, so the parent
+    // stays small.
+    Input other;
+    if (i > cloud_paths.size())
+      other = sampleSurface(vertices, triangles, sizes[i - 1 - cloud_paths.size()]);
+    else if (i > 0 && !loadCloud(cloud_paths[i - 1], "cloud", other, error))
+      return fail(error);
+    const Input &input = i == 0 ? bunny : other;
 
-    std::vector<std::pair<std::string, std::function<Measurement(const Input &)>>> methods = {
-        {"pcl_ms", runPclMs}};
-    if (!skip_afsr)
+    std::vector<std::pair<std::string, std::function<Measurement(const Input &)>>> methods;
+    const auto suffix = [](std::size_t threads) {
+      return threads == 1 ? std::string() : " " + std::to_string(threads) + " threads";
+    };
+    for (std::size_t threads : thread_counts)
+      methods.emplace_back("pcl_ms" + suffix(threads), [threads, one_piece](const Input &points) {
+        return runPclMs(points, static_cast<int>(threads), one_piece);
+      });
+    if (!skip_afsr && (afsr_limit.empty() || input.size() <= afsr_limit.front()))
       methods.emplace_back("AFSR", runAfsr);
-    methods.emplace_back("Delaunay 3D", runDelaunay);
+    for (std::size_t threads : thread_counts)
+      if (threads == 1)
+        methods.emplace_back("Delaunay 3D", runDelaunay);
+      else
+        methods.emplace_back("Delaunay 3D" + suffix(threads), [threads](const Input &points) {
+          return runParallelDelaunay(points, static_cast<int>(threads));
+        });
 
     std::vector<Run> runs;
     runs.push_back(runInChild("input only", runNothing, input));
