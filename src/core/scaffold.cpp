@@ -115,15 +115,19 @@ bool isGabriel(const Delaunay &delaunay, CellHandle cell, int i,
   return true;
 }
 
-Circle circumcircle(const Eigen::Vector3d &a, const Eigen::Vector3d &b, const Eigen::Vector3d &c) {
+/// The circumcircle of a, b, c; its unit normal only if asked for (the
+/// local scales, which see every facet, need centre and radius only).
+Circle circumcircle(const Eigen::Vector3d &a, const Eigen::Vector3d &b, const Eigen::Vector3d &c,
+                    bool with_normal = true) {
   const Eigen::Vector3d u = b - a, v = c - a, w = u.cross(v);
   const double w_squared = w.squaredNorm();
-  Circle circle;
+  Circle circle{};
   const Eigen::Vector3d offset =
       (u.squaredNorm() * v.cross(w) + v.squaredNorm() * w.cross(u)) / (2.0 * w_squared);
   circle.centre = a + offset;
   circle.radius = offset.norm();
-  circle.unit_normal = w / std::sqrt(w_squared);
+  if (with_normal)
+    circle.unit_normal = w / std::sqrt(w_squared);
   return circle;
 }
 
@@ -303,7 +307,7 @@ private:
                              return;
                            }
                            const Eigen::Vector3d p = toEigen(a), q = toEigen(b), r = toEigen(c);
-                           const Circle circle = circumcircle(p, q, r);
+                           const Circle circle = circumcircle(p, q, r, false);
                            const bool is_gabriel =
                                scaffold_.planar || isGabriel(delaunay, cell, i, vertices, circle,
                                                              triangleShape(p, q, r).compactness);
@@ -502,7 +506,10 @@ private:
                     return;
                   }
                   const TriangleShape shape = triangleShape(a, b, c);
-                  const Circle circle = circumcircle(a, b, c);
+                  // Types I and II measure their shock from the circle;
+                  // type III needs it only for the normal term.
+                  const bool needs_circle = (gabriel && !scaffold_.planar) || options_.normals;
+                  const Circle circle = needs_circle ? circumcircle(a, b, c) : Circle{};
                   double shock_length;
                   if (scaffold_.planar) {
                     // Both Voronoi pieces are infinite in a plane: rank by shape and size.
