@@ -155,6 +155,12 @@ void analyzeVertexFans(const std::vector<Triangle> &triangles, std::size_t verte
   std::vector<EdgeAtVertex> incident_edges;
   std::vector<BoundaryAtVertex> boundary;
   std::vector<BoundaryAtVertex> unpaired;
+  // One forest for every vertex's fans, reset per vertex: sized for the
+  // vertex with the most triangles, so the loop allocates nothing.
+  std::size_t most_triangles = 0;
+  for (std::size_t vertex = 0; vertex < vertex_count; ++vertex)
+    most_triangles = std::max(most_triangles, corners_begin[vertex + 1] - corners_begin[vertex]);
+  DisjointSets fans(most_triangles);
 
   for (std::size_t vertex = 0; vertex < vertex_count; ++vertex) {
     const std::size_t begin = corners_begin[vertex], end = corners_begin[vertex + 1];
@@ -172,7 +178,8 @@ void analyzeVertexFans(const std::vector<Triangle> &triangles, std::size_t verte
     std::sort(incident_edges.begin(), incident_edges.end());
 
     // Triangles form one fan when linked through edges with two triangles.
-    DisjointSets fans(end - begin);
+    for (std::size_t local = 0; local < end - begin; ++local)
+      fans.make_set(local);
     bool on_non_manifold_edge = false;
     for (std::size_t k = 0; k < incident_edges.size();) {
       std::size_t run_end = k + 1;
