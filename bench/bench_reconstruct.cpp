@@ -364,21 +364,29 @@ void printHelp(const char *program) {
               program);
 }
 
+/// The items of a comma-separated list (an empty text has one empty item).
+std::vector<std::string> splitList(const std::string &text) {
+  std::vector<std::string> items;
+  for (std::size_t start = 0; start <= text.size();) {
+    std::size_t end = text.find(',', start);
+    if (end == std::string::npos)
+      end = text.size();
+    items.push_back(text.substr(start, end - start));
+    start = end + 1;
+  }
+  return items;
+}
+
 bool parseSizes(const std::string &text, std::vector<std::size_t> &sizes, std::size_t minimum = 4) {
   sizes.clear();
   if (text == "none")
     return true;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    std::size_t end = text.find(',', start);
-    if (end == std::string::npos)
-      end = text.size();
+  for (const std::string &item : splitList(text)) {
     std::size_t value = 0;
-    const auto [last, code] = std::from_chars(text.data() + start, text.data() + end, value);
-    if (code != std::errc() || last != text.data() + end || value < minimum)
+    const auto [last, code] = std::from_chars(item.data(), item.data() + item.size(), value);
+    if (code != std::errc() || last != item.data() + item.size() || value < minimum)
       return false;
     sizes.push_back(value);
-    start = end + 1;
   }
   return true;
 }
@@ -427,18 +435,8 @@ int main(int argc, char **argv) {
   if (!parseSizes(threads_text, thread_counts, 1) || thread_counts.empty())
     return fail("-threads: expected a comma-separated list of numbers >= 1, got '" + threads_text +
                 "'");
-  std::vector<std::string> cloud_paths;
-  for (std::size_t start = 0; !clouds_text.empty() && start <= clouds_text.size();) {
-    std::size_t end = clouds_text.find(',', start);
-    if (end == std::string::npos)
-      end = clouds_text.size();
-    cloud_paths.push_back(clouds_text.substr(start, end - start));
-    start = end + 1;
-  }
-  // A missing file fails before anything is loaded.
-  for (const std::string &path : cloud_paths)
-    if (!std::ifstream(path))
-      return fail("-clouds: cannot read '" + path + "'");
+  const std::vector<std::string> cloud_paths =
+      clouds_text.empty() ? std::vector<std::string>() : splitList(clouds_text);
   int repeat = 1;
   pcl::console::parse_argument(argc, argv, "-repeat", repeat);
   if (repeat < 1 || repeat > 100)
@@ -460,6 +458,14 @@ int main(int argc, char **argv) {
   // PCL's readers explain failures on stderr themselves; we print one line.
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
   std::string error;
+  // An unusable cloud fails before anything else is loaded or run: each is
+  // read once here (a file that opens may still not parse or hold too few
+  // finite points), and again at its turn, so the parent stays small.
+  for (const std::string &path : cloud_paths) {
+    Input probe;
+    if (!loadCloud(path, "cloud", probe, error))
+      return fail("-clouds: " + error);
+  }
   Input bunny;
   if (!loadCloud(data_dir + "/bunny.pcd", "bunny vertices", bunny, error))
     return fail(error);
@@ -467,13 +473,6 @@ int main(int argc, char **argv) {
   std::vector<pcl_ms::Triangle> triangles;
   if (!sizes.empty() && !pcl_ms::loadMesh(mesh_path, vertices, triangles, error))
     return fail(error);
-  // Fail before the first run, not after the bunny's: read every cloud once
-  // (a file that opens may still not parse or hold too few finite points).
-  for (const std::string &path : cloud_paths) {
-    Input probe;
-    if (!loadCloud(path, "cloud", probe, error))
-      return fail("-clouds: " + error);
-  }
 
   std::printf("bench_reconstruct: threads %s%s; each method in a forked child, peak = its "
               "VmHWM.\n'above input' subtracts the peak of a child that only holds the "
