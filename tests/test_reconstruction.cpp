@@ -84,7 +84,8 @@ TEST(Bunny, RecoversTheReferenceSurface) {
   EXPECT_LE(memory.prepare, memory.scaffold);
   EXPECT_LE(memory.scaffold, memory.greedy);
   EXPECT_LE(memory.greedy, memory.finish);
-  // Every Delaunay triangle is counted once: kept by type, too long, or flat.
+  // The Delaunay triangles are reported by what became of them: kept by
+  // type, too long, or flat (none on the bunny).
   const pcl_ms::Result &counts = bunny.result;
   EXPECT_GT(counts.candidates_type1, counts.candidates_type2);
   EXPECT_GT(counts.candidates_type3, 0u);
