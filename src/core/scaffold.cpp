@@ -177,6 +177,44 @@ template <typename Iterator> float medianOf(Iterator first, Iterator last) {
 
 double median(std::vector<float> &values) { return medianOf(values.begin(), values.end()); }
 
+/// What the local scales' pass finds out about a facet, for the candidates'.
+enum class FacetKind : std::uint8_t { collinear, gabriel, other };
+
+// |u x v|^2 above this times |u|^2 |v|^2 (a sine above 1e-10) cannot come
+// from rounding (about 1e-15 relative): those facets skip the exact test.
+constexpr double surely_not_collinear = 1e-20;
+
+// A dot product whose square exceeds this times |x|^2 |y|^2 has the sign of
+// the exact one.
+constexpr double surely_signed = 1e-24;
+
+/// Whether every angle of the facet is acute, decided exactly: the
+/// floating-point dot products where their sign is certain, CGAL's exact
+/// test for the rest. a, b, c are the coordinates of the handles' points, in
+/// any order.
+bool allAnglesAcute(const Eigen::Vector3d &a, const Eigen::Vector3d &b, const Eigen::Vector3d &c,
+                    const std::array<VertexHandle, 3> &handles) {
+  const Eigen::Vector3d ab = b - a, bc = c - b, ca = a - c;
+  const double ab2 = ab.squaredNorm(), bc2 = bc.squaredNorm(), ca2 = ca.squaredNorm();
+  // The angles at a, b and c.
+  const double dots[3] = {-ab.dot(ca), -bc.dot(ab), -ca.dot(bc)};
+  const double scales[3] = {ab2 * ca2, bc2 * ab2, ca2 * bc2};
+  bool certain = true;
+  for (int k = 0; k < 3; ++k) {
+    if (!(dots[k] * dots[k] > surely_signed * scales[k]))
+      certain = false;
+    else if (dots[k] < 0)
+      return false;
+  }
+  if (certain)
+    return true;
+  return CGAL::angle(handles[2]->point(), handles[0]->point(), handles[1]->point()) ==
+             CGAL::ACUTE &&
+         CGAL::angle(handles[0]->point(), handles[1]->point(), handles[2]->point()) ==
+             CGAL::ACUTE &&
+         CGAL::angle(handles[1]->point(), handles[2]->point(), handles[0]->point()) == CGAL::ACUTE;
+}
+
 /// Per-chunk output of the candidate pass.
 struct ChunkCandidates {
   std::vector<Candidate> candidates;
@@ -205,7 +243,7 @@ public:
     // The tetrahedra are no longer needed: free them before the edge graph.
     cells_.clear();
     cells_.shrink_to_fit();
-    chunk_gabriel_ = {};
+    chunk_kinds_ = {};
     delaunay.clear();
     if (options_.fixed_triangles)
       addFixedTriangles(*options_.fixed_triangles);
@@ -289,37 +327,41 @@ private:
       float circumradius;
     };
     std::vector<std::vector<GabrielTriangle>> chunk_triangles(chunkCount(cells_.size()));
-    chunk_gabriel_.assign(chunkCount(cells_.size()), {});
-    forEachChunk(cells_.size(), options_.num_threads,
-                 [&](std::size_t chunk, std::size_t begin, std::size_t end) {
-                   auto &gabriel = chunk_triangles[chunk];
-                   std::vector<bool> &flags = chunk_gabriel_[chunk];
-                   for (std::size_t index = begin; index < end; ++index) {
-                     if (!scaffold_.planar)
-                       prefetchNeighbours(cells_, index + neighbour_prefetch_distance);
-                     forEachOwnedFacet(
-                         delaunay, cells_[index],
-                         [&](CellHandle cell, int i, const auto &vertices) {
-                           const KernelPoint &a = vertices[0]->point(), &b = vertices[1]->point(),
-                                             &c = vertices[2]->point();
-                           if (CGAL::collinear(a, b, c)) {
-                             flags.push_back(false);
-                             return;
-                           }
-                           const Eigen::Vector3d p = toEigen(a), q = toEigen(b), r = toEigen(c);
-                           const Circle circle = circumcircle(p, q, r, false);
-                           const bool is_gabriel =
-                               scaffold_.planar || isGabriel(delaunay, cell, i, vertices, circle,
-                                                             triangleShape(p, q, r).compactness);
-                           flags.push_back(is_gabriel);
-                           if (!is_gabriel)
-                             return;
-                           gabriel.push_back(
-                               {{vertices[0]->info(), vertices[1]->info(), vertices[2]->info()},
-                                static_cast<float>(circle.radius)});
-                         });
-                   }
-                 });
+    chunk_kinds_.assign(chunkCount(cells_.size()), {});
+    forEachChunk(
+        cells_.size(), options_.num_threads,
+        [&](std::size_t chunk, std::size_t begin, std::size_t end) {
+          auto &gabriel = chunk_triangles[chunk];
+          std::vector<FacetKind> &kinds = chunk_kinds_[chunk];
+          for (std::size_t index = begin; index < end; ++index) {
+            if (!scaffold_.planar)
+              prefetchNeighbours(cells_, index + neighbour_prefetch_distance);
+            forEachOwnedFacet(
+                delaunay, cells_[index], [&](CellHandle cell, int i, const auto &vertices) {
+                  const KernelPoint &a = vertices[0]->point(), &b = vertices[1]->point(),
+                                    &c = vertices[2]->point();
+                  const Eigen::Vector3d p = toEigen(a), q = toEigen(b), r = toEigen(c);
+                  const Eigen::Vector3d u = q - p, v = r - p, w = u.cross(v);
+                  const double uu = u.squaredNorm(), vv = v.squaredNorm(), ww = w.squaredNorm();
+                  if (!(ww > surely_not_collinear * uu * vv) && CGAL::collinear(a, b, c)) {
+                    kinds.push_back(FacetKind::collinear);
+                    return;
+                  }
+                  const Circle circle = circumcircle(p, q, r, false);
+                  // 4 sqrt(3) A / (d1^2 + d2^2 + d3^2), A = |w| / 2.
+                  const double compactness =
+                      2 * std::sqrt(3.0) * std::sqrt(ww) / (uu + vv + (v - u).squaredNorm());
+                  const bool is_gabriel = scaffold_.planar || isGabriel(delaunay, cell, i, vertices,
+                                                                        circle, compactness);
+                  kinds.push_back(is_gabriel ? FacetKind::gabriel : FacetKind::other);
+                  if (!is_gabriel)
+                    return;
+                  gabriel.push_back(
+                      {{vertices[0]->info(), vertices[1]->info(), vertices[2]->info()},
+                       static_cast<float>(circle.radius)});
+                });
+          }
+        });
     // Each point's Gabriel triangles (CSR): their circumradii and, two per
     // triangle, the other corners.
     std::vector<std::uint32_t> offsets(n + 1, 0);
@@ -442,9 +484,9 @@ private:
   double shockLength(const Delaunay &delaunay, CellHandle cell, int i, const Circle &circle) const {
     double shortest = std::numeric_limits<double>::infinity();
     for (CellHandle side : {cell, cell->neighbor(i)}) {
-      if (delaunay.is_infinite(side) || detail::hasNoCircumcentre(side))
+      Eigen::Vector3d voronoi_vertex;
+      if (delaunay.is_infinite(side) || !detail::circumcentre(side, voronoi_vertex.data()))
         continue; // that piece is a ray (or as long as one): infinitely long
-      const Eigen::Vector3d voronoi_vertex = toEigen(delaunay.dual(side));
       shortest =
           std::min(shortest, std::abs((voronoi_vertex - circle.centre).dot(circle.unit_normal)));
     }
@@ -474,14 +516,15 @@ private:
         [&](std::size_t chunk, std::size_t begin, std::size_t end) {
           ChunkCandidates &out = chunks[chunk];
           // The facets come in the order measureLocalScales saw them in.
-          std::vector<bool>::const_iterator gabriel_flag = chunk_gabriel_[chunk].begin();
+          std::vector<FacetKind>::const_iterator kind = chunk_kinds_[chunk].begin();
           for (std::size_t index = begin; index < end; ++index) {
             if (!scaffold_.planar)
               prefetchNeighbours(cells_, index + neighbour_prefetch_distance);
             forEachOwnedFacet(
                 delaunay, cells_[index],
                 [&](CellHandle cell, int i, const std::array<VertexHandle, 3> &handles) {
-                  const bool gabriel = *gabriel_flag++;
+                  const FacetKind facet_kind = *kind++;
+                  const bool gabriel = facet_kind == FacetKind::gabriel;
                   Candidate candidate;
                   for (int k = 0; k < 3; ++k)
                     candidate.vertices[k] = handles[k]->info();
@@ -500,8 +543,7 @@ private:
                     ++out.oversize;
                     return;
                   }
-                  if (CGAL::collinear(handles[0]->point(), handles[1]->point(),
-                                      handles[2]->point())) {
+                  if (facet_kind == FacetKind::collinear) {
                     ++out.degenerate;
                     return;
                   }
@@ -516,13 +558,8 @@ private:
                     candidate.type = CandidateType::acute;
                     shock_length = local_scale;
                   } else if (gabriel) {
-                    const bool acute = CGAL::angle(handles[2]->point(), handles[0]->point(),
-                                                   handles[1]->point()) == CGAL::ACUTE &&
-                                       CGAL::angle(handles[0]->point(), handles[1]->point(),
-                                                   handles[2]->point()) == CGAL::ACUTE &&
-                                       CGAL::angle(handles[1]->point(), handles[2]->point(),
-                                                   handles[0]->point()) == CGAL::ACUTE;
-                    candidate.type = acute ? CandidateType::acute : CandidateType::obtuse;
+                    candidate.type = allAnglesAcute(a, b, c, handles) ? CandidateType::acute
+                                                                      : CandidateType::obtuse;
                     shock_length = shockLength(delaunay, cell, i, circle);
                   } else {
                     // Type III has no A1^3-2 point on its curve: use the local spacing.
@@ -744,9 +781,9 @@ private:
   const ScaffoldOptions &options_;
   MedialScaffold scaffold_;
   std::vector<CellHandle> cells_;
-  /// Per chunk of cells, whether each facet visited is a Gabriel triangle
-  /// (measured once for the local scales, read again for the candidates).
-  std::vector<std::vector<bool>> chunk_gabriel_;
+  /// Per chunk of cells, what each facet visited is (measured once for the
+  /// local scales, read again for the candidates).
+  std::vector<std::vector<FacetKind>> chunk_kinds_;
 };
 
 } // namespace
