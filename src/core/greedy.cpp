@@ -399,6 +399,8 @@ void GreedyMesher::Impl::keepClosedFanOnly(VertexIndex v) {
     multi_fan_vertex_[v] = false;
     return;
   }
+  if (!mesh_.hasClosedFan(v)) // the common case: no need to build the fans
+    return;
   const auto fans = mesh_.fansAround(v);
   const std::vector<CandidateIndex> *closed = nullptr;
   for (const auto &fan : fans)

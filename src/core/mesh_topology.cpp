@@ -119,4 +119,30 @@ bool MeshTopology::isSingleFan(VertexIndex v) const {
   return reached == around.size();
 }
 
+bool MeshTopology::hasClosedFan(VertexIndex v) const {
+  const auto isInner = [&](CandidateIndex t) {
+    const auto edges = edgesAt(t, v);
+    return edgeTriangleCount(edges[0]) == 2 && edgeTriangleCount(edges[1]) == 2;
+  };
+  // Inner triangles link to two others at v: a walk from one returns to it
+  // exactly when its fan is a ring of inner triangles.
+  for (CandidateIndex start : vertex_triangles_[v]) {
+    if (!isInner(start))
+      continue;
+    CandidateIndex current = start;
+    EdgeIndex through = edgesAt(start, v)[0];
+    for (;;) {
+      const CandidateIndex next = otherTriangle(through, current);
+      if (next == start)
+        return true;
+      if (!isInner(next))
+        break;
+      const auto edges = edgesAt(next, v);
+      through = edges[0] == through ? edges[1] : edges[0];
+      current = next;
+    }
+  }
+  return false;
+}
+
 } // namespace pcl_ms

@@ -82,6 +82,9 @@ public:
   /// Whether v's triangles (if any) form one fan: fansAround(v).size() <= 1,
   /// found by walking the fan without building it.
   bool isSingleFan(VertexIndex v) const;
+  /// Whether one of v's fans is closed (a ring of triangles whose edges at
+  /// v all hold two), found by walking without building the fans.
+  bool hasClosedFan(VertexIndex v) const;
 
   /// The two edges of candidate t that contain vertex v; std::logic_error
   /// when v is not a corner of t.
