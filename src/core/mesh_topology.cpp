@@ -16,14 +16,7 @@ MeshTopology::MeshTopology(const MedialScaffold &scaffold, std::size_t vertex_co
       vertex_triangles_(vertex_count), vertex_counts_(vertex_count),
       in_mesh_(scaffold.candidates.size(), false) {}
 
-std::array<EdgeIndex, 2> MeshTopology::edgesAt(CandidateIndex t, VertexIndex v) const {
-  const Candidate &candidate = scaffold_.candidates[t];
-  // edges[k] joins vertices[k] and vertices[k + 1]: vertex k lies on edges k and k - 1.
-  for (int k = 0; k < 3; ++k)
-    if (candidate.vertices[k] == v)
-      return {candidate.edges[k], candidate.edges[(k + 2) % 3]};
-  // Callers walk the triangles around v; anything else is a broken invariant,
-  // which must stop the run rather than quietly use some edge.
+void MeshTopology::notACorner(CandidateIndex t, VertexIndex v) {
   throw std::logic_error("MeshTopology::edgesAt: vertex " + std::to_string(v) +
                          " is not a corner of candidate " + std::to_string(t));
 }

@@ -87,12 +87,24 @@ public:
   bool hasClosedFan(VertexIndex v) const;
 
   /// The two edges of candidate t that contain vertex v; std::logic_error
-  /// when v is not a corner of t.
-  std::array<EdgeIndex, 2> edgesAt(CandidateIndex t, VertexIndex v) const;
+  /// when v is not a corner of t. Inline: the greedy's rules ask it on
+  /// every decision.
+  std::array<EdgeIndex, 2> edgesAt(CandidateIndex t, VertexIndex v) const {
+    const Candidate &candidate = scaffold_.candidates[t];
+    // edges[k] joins vertices[k] and vertices[k + 1]: vertex k lies on edges k and k - 1.
+    for (int k = 0; k < 3; ++k)
+      if (candidate.vertices[k] == v)
+        return {candidate.edges[k], candidate.edges[(k + 2) % 3]};
+    notACorner(t, v);
+  }
 
   std::size_t size() const { return triangle_count_; }
 
 private:
+  /// Callers walk the triangles around v; anything else is a broken
+  /// invariant, which must stop the run rather than quietly use some edge.
+  [[noreturn]] static void notACorner(CandidateIndex t, VertexIndex v);
+
   const MedialScaffold &scaffold_;
   std::vector<std::array<CandidateIndex, 2>> edge_slots_;
   std::vector<VertexTriangles> vertex_triangles_;
