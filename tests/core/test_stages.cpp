@@ -10,10 +10,12 @@
 #include <pcl_ms/mesh_topology.h>
 #include <pcl_ms/scaffold.h>
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <map>
+#include <random>
 #include <set>
 #include <stdexcept>
 #include <utility>
@@ -191,6 +193,44 @@ TEST(Scaffold, ObtuseGabrielTriangleIsTypeTwo) {
   const Candidate *base = findCandidate(scaffold, {0, 1, 2});
   ASSERT_NE(base, nullptr);
   EXPECT_EQ(base->type, CandidateType::obtuse);
+}
+
+// On a grid, right angles and co-circular corners go to CGAL's exact tests;
+// on a jittered grid the floating-point filters decide: both must give the
+// exact verdict on every Gabriel candidate.
+TEST(Scaffold, AcuteAndObtuseTypesAgreeWithExactAngles) {
+  using ExactPoint = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
+  for (double jitter : {0.0, 0.3}) {
+    std::mt19937 random(7);
+    std::uniform_real_distribution<double> offset(-jitter, jitter);
+    std::vector<Eigen::Vector3d> points;
+    for (int x = 0; x < 5; ++x)
+      for (int y = 0; y < 5; ++y)
+        for (int z = 0; z < 5; ++z)
+          points.emplace_back(x + offset(random), y + offset(random), z + offset(random));
+    ScaffoldOptions options;
+    options.rho = 100; // every facet is a candidate
+    const MedialScaffold scaffold = buildMedialScaffold(points, options);
+    std::size_t gabriel = 0, right_angles = 0;
+    for (const Candidate &candidate : scaffold.candidates) {
+      if (candidate.type == CandidateType::ambiguous)
+        continue;
+      ++gabriel;
+      const auto corner = [&](int k) {
+        const Eigen::Vector3d &p = points[candidate.vertices[k % 3]];
+        return ExactPoint(p.x(), p.y(), p.z());
+      };
+      bool acute = true;
+      for (int k = 0; k < 3; ++k) {
+        const CGAL::Angle angle = CGAL::angle(corner(k + 1), corner(k), corner(k + 2));
+        acute &= angle == CGAL::ACUTE;
+        right_angles += angle == CGAL::RIGHT;
+      }
+      EXPECT_EQ(candidate.type == CandidateType::acute, acute);
+    }
+    EXPECT_GT(gabriel, 200u);
+    EXPECT_EQ(right_angles > 0, jitter == 0) << "right angles: " << right_angles;
+  }
 }
 
 TEST(Scaffold, TriangleWithPointInItsDiametralSphereIsTypeThree) {
