@@ -115,19 +115,27 @@ bool isGabriel(const Delaunay &delaunay, CellHandle cell, int i,
   return true;
 }
 
-/// The circumcircle of a, b, c; its unit normal only if asked for (the
-/// local scales, which see every facet, need centre and radius only).
-Circle circumcircle(const Eigen::Vector3d &a, const Eigen::Vector3d &b, const Eigen::Vector3d &c,
-                    bool with_normal = true) {
-  const Eigen::Vector3d u = b - a, v = c - a, w = u.cross(v);
-  const double w_squared = w.squaredNorm();
+/// Triangle a, b, c's edge vectors from a and their squared lengths: what
+/// its circumcircle, its compactness and the collinearity filter share.
+struct EdgeVectors {
+  EdgeVectors(const Eigen::Vector3d &a, const Eigen::Vector3d &b, const Eigen::Vector3d &c)
+      : u(b - a), v(c - a), w(u.cross(v)), uu(u.squaredNorm()), vv(v.squaredNorm()),
+        ww(w.squaredNorm()) {}
+  Eigen::Vector3d u, v, w; // b - a, c - a, u x v
+  double uu, vv, ww;
+};
+
+/// The circumcircle of the triangle with corner a and edge vectors `edges`;
+/// its unit normal only if asked for (the local scales, which see every
+/// facet, need centre and radius only).
+Circle circumcircle(const Eigen::Vector3d &a, const EdgeVectors &edges, bool with_normal = true) {
   Circle circle{};
   const Eigen::Vector3d offset =
-      (u.squaredNorm() * v.cross(w) + v.squaredNorm() * w.cross(u)) / (2.0 * w_squared);
+      (edges.uu * edges.v.cross(edges.w) + edges.vv * edges.w.cross(edges.u)) / (2.0 * edges.ww);
   circle.centre = a + offset;
   circle.radius = offset.norm();
   if (with_normal)
-    circle.unit_normal = w / std::sqrt(w_squared);
+    circle.unit_normal = edges.w / std::sqrt(edges.ww);
   return circle;
 }
 
@@ -340,17 +348,18 @@ private:
                 delaunay, cells_[index], [&](CellHandle cell, int i, const auto &vertices) {
                   const KernelPoint &a = vertices[0]->point(), &b = vertices[1]->point(),
                                     &c = vertices[2]->point();
-                  const Eigen::Vector3d p = toEigen(a), q = toEigen(b), r = toEigen(c);
-                  const Eigen::Vector3d u = q - p, v = r - p, w = u.cross(v);
-                  const double uu = u.squaredNorm(), vv = v.squaredNorm(), ww = w.squaredNorm();
-                  if (!(ww > surely_not_collinear * uu * vv) && CGAL::collinear(a, b, c)) {
+                  const Eigen::Vector3d p = toEigen(a);
+                  const EdgeVectors edges(p, toEigen(b), toEigen(c));
+                  if (!(edges.ww > surely_not_collinear * edges.uu * edges.vv) &&
+                      CGAL::collinear(a, b, c)) {
                     kinds.push_back(FacetKind::collinear);
                     return;
                   }
-                  const Circle circle = circumcircle(p, q, r, false);
+                  const Circle circle = circumcircle(p, edges, false);
                   // 4 sqrt(3) A / (d1^2 + d2^2 + d3^2), A = |w| / 2.
                   const double compactness =
-                      2 * std::sqrt(3.0) * std::sqrt(ww) / (uu + vv + (v - u).squaredNorm());
+                      2 * std::sqrt(3.0) * std::sqrt(edges.ww) /
+                      (edges.uu + edges.vv + (edges.v - edges.u).squaredNorm());
                   const bool is_gabriel = scaffold_.planar || isGabriel(delaunay, cell, i, vertices,
                                                                         circle, compactness);
                   kinds.push_back(is_gabriel ? FacetKind::gabriel : FacetKind::other);
@@ -551,7 +560,8 @@ private:
                   // Types I and II measure their shock from the circle;
                   // type III needs it only for the normal term.
                   const bool needs_circle = (gabriel && !scaffold_.planar) || options_.normals;
-                  const Circle circle = needs_circle ? circumcircle(a, b, c) : Circle{};
+                  const Circle circle =
+                      needs_circle ? circumcircle(a, EdgeVectors(a, b, c)) : Circle{};
                   double shock_length;
                   if (scaffold_.planar) {
                     // Both Voronoi pieces are infinite in a plane: rank by shape and size.
