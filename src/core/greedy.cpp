@@ -8,6 +8,7 @@
 #include <pcl_ms/costs.h>
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
 namespace pcl_ms {
@@ -388,11 +389,8 @@ void GreedyMesher::Impl::keepClosedFanOnly(VertexIndex v) {
   // A closed fan has at least three triangles whose both edges at v are
   // full: without them there is nothing to do, and no fans to build.
   int inner_triangles = 0;
-  for (CandidateIndex u : mesh_.vertexTriangles(v)) {
-    const auto edges = mesh_.edgesAt(u, v);
-    inner_triangles +=
-        mesh_.edgeTriangleCount(edges[0]) == 2 && mesh_.edgeTriangleCount(edges[1]) == 2;
-  }
+  for (CandidateIndex u : mesh_.vertexTriangles(v))
+    inner_triangles += mesh_.isInnerAt(u, v);
   if (inner_triangles < 3)
     return;
   if (mesh_.isSingleFan(v)) {
@@ -404,10 +402,10 @@ void GreedyMesher::Impl::keepClosedFanOnly(VertexIndex v) {
   const auto fans = mesh_.fansAround(v);
   const std::vector<CandidateIndex> *closed = nullptr;
   for (const auto &fan : fans)
-    if (isClosedFan(fan, v))
+    if (std::all_of(fan.begin(), fan.end(),
+                    [&](CandidateIndex u) { return mesh_.isInnerAt(u, v); }))
       closed = &fan;
-  if (!closed)
-    return;
+  assert(closed && "hasClosedFan walked a ring of inner triangles: that fan");
   for (const auto &fan : fans)
     if (&fan != closed)
       for (CandidateIndex u : fan)
@@ -424,14 +422,6 @@ void GreedyMesher::Impl::removeFromMesh(CandidateIndex t) {
   propagateContext(t, -1.0);
   for (VertexIndex v : candidates_[t].vertices)
     may_have_several_fans_[v] = true;
-}
-
-bool GreedyMesher::Impl::isClosedFan(const std::vector<CandidateIndex> &fan, VertexIndex v) const {
-  for (CandidateIndex u : fan)
-    for (EdgeIndex e : mesh_.edgesAt(u, v))
-      if (mesh_.edgeTriangleCount(e) != 2)
-        return false;
-  return true;
 }
 
 /// Takes t out of the mesh and sends it to Q2 with a fresh cost.

@@ -131,7 +131,6 @@ private:
   void accept(CandidateIndex t, bool created_second_fan);
   void keepClosedFanOnly(VertexIndex v);
   void removeFromMesh(CandidateIndex t);
-  bool isClosedFan(const std::vector<CandidateIndex> &fan, VertexIndex v) const;
   void undo(CandidateIndex t);
   void removeFlapsAndIsolatedTriangles();
 

@@ -113,14 +113,10 @@ bool MeshTopology::isSingleFan(VertexIndex v) const {
 }
 
 bool MeshTopology::hasClosedFan(VertexIndex v) const {
-  const auto isInner = [&](CandidateIndex t) {
-    const auto edges = edgesAt(t, v);
-    return edgeTriangleCount(edges[0]) == 2 && edgeTriangleCount(edges[1]) == 2;
-  };
   // Inner triangles link to two others at v: a walk from one returns to it
   // exactly when its fan is a ring of inner triangles.
   for (CandidateIndex start : vertex_triangles_[v]) {
-    if (!isInner(start))
+    if (!isInnerAt(start, v))
       continue;
     CandidateIndex current = start;
     EdgeIndex through = edgesAt(start, v)[0];
@@ -128,7 +124,7 @@ bool MeshTopology::hasClosedFan(VertexIndex v) const {
       const CandidateIndex next = otherTriangle(through, current);
       if (next == start)
         return true;
-      if (!isInner(next))
+      if (!isInnerAt(next, v))
         break;
       const auto edges = edgesAt(next, v);
       through = edges[0] == through ? edges[1] : edges[0];

@@ -82,9 +82,15 @@ public:
   /// Whether v's triangles (if any) form one fan: fansAround(v).size() <= 1,
   /// found by walking the fan without building it.
   bool isSingleFan(VertexIndex v) const;
-  /// Whether one of v's fans is closed (a ring of triangles whose edges at
-  /// v all hold two), found by walking without building the fans.
+  /// Whether one of v's fans is closed (a ring of inner triangles, see
+  /// isInnerAt), found by walking without building the fans.
   bool hasClosedFan(VertexIndex v) const;
+  /// Whether both of t's edges at v hold two triangles: t is inside v's
+  /// fan, not at its rim.
+  bool isInnerAt(CandidateIndex t, VertexIndex v) const {
+    const auto edges = edgesAt(t, v);
+    return edgeTriangleCount(edges[0]) == 2 && edgeTriangleCount(edges[1]) == 2;
+  }
 
   /// The two edges of candidate t that contain vertex v; std::logic_error
   /// when v is not a corner of t. Inline: the greedy's rules ask it on
