@@ -343,28 +343,40 @@ MedialScaffold scaffoldOfTriangles(const std::vector<Triangle> &triangles) {
 
 } // namespace
 
-TEST(MeshTopology, SingleFanTestAgreesWithTheFans) {
+TEST(MeshTopology, SingleAndClosedFanTestsAgreeWithTheFans) {
   // Vertex 0 is the centre of a closed ring of six triangles and of a
-  // separate open fan of two: every subset of them is tried.
+  // separate open fan of two: every subset of them is tried. A fan is closed
+  // when every edge its triangles have at the vertex holds two triangles.
   std::vector<Triangle> triangles;
   for (VertexIndex i = 1; i <= 6; ++i)
     triangles.push_back({0, i, i % 6 + 1});
   triangles.push_back({0, 7, 8});
   triangles.push_back({0, 8, 9});
   const MedialScaffold scaffold = scaffoldOfTriangles(triangles);
-  int several_fans = 0;
+  int several_fans = 0, closed_beside_others = 0;
   for (unsigned subset = 0; subset < (1u << triangles.size()); ++subset) {
     MeshTopology mesh(scaffold, 10);
     for (CandidateIndex t = 0; t < triangles.size(); ++t)
       if (subset & (1u << t))
         mesh.add(t);
-    for (VertexIndex v = 0; v < 10; ++v)
-      ASSERT_EQ(mesh.isSingleFan(v), mesh.fansAround(v).size() <= 1)
-          << "vertex " << v << ", subset " << subset;
+    for (VertexIndex v = 0; v < 10; ++v) {
+      const auto fans = mesh.fansAround(v);
+      ASSERT_EQ(mesh.isSingleFan(v), fans.size() <= 1) << "vertex " << v << ", subset " << subset;
+      bool closed = false;
+      for (const auto &fan : fans)
+        closed |= std::all_of(fan.begin(), fan.end(), [&](CandidateIndex t) {
+          const auto edges = mesh.edgesAt(t, v);
+          return mesh.edgeTriangleCount(edges[0]) == 2 && mesh.edgeTriangleCount(edges[1]) == 2;
+        });
+      ASSERT_EQ(mesh.hasClosedFan(v), closed) << "vertex " << v << ", subset " << subset;
+      closed_beside_others += closed && fans.size() > 1;
+    }
     several_fans += !mesh.isSingleFan(0);
   }
-  // Sanity check of the enumeration: bow-ties at the centre are common.
+  // Sanity check of the enumeration: bow-ties at the centre are common, and
+  // the closed ring meets the open fan in three subsets.
   EXPECT_GT(several_fans, 100);
+  EXPECT_EQ(closed_beside_others, 3);
 }
 
 // ---- greedy ------------------------------------------------------------------------
