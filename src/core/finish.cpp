@@ -6,6 +6,8 @@
 #include "finish_steps.h"
 
 #include <algorithm>
+#include <array>
+#include <utility>
 
 namespace pcl_ms {
 namespace detail {
@@ -81,8 +83,10 @@ void forEachEdge(const std::vector<Triangle> &triangles, std::size_t block_uses,
 MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_neighbours,
                     std::size_t block_uses) {
   MeshEdges edges;
-  if (with_neighbours)
+  if (with_neighbours) {
+    edges.neighbours.reserve(3 * triangles.capacity());
     edges.neighbours.assign(3 * triangles.size(), no_neighbour);
+  }
   // Edges come in key order, so each triangle's slots fill in that order.
   auto addNeighbour = [&](std::uint32_t t, std::uint32_t u) {
     std::uint32_t *slot = &edges.neighbours[3 * std::size_t{t}];
@@ -93,12 +97,100 @@ MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_neighbours
   forEachEdge(triangles, block_uses, [&](EdgeKey key, const EdgeUse *first, std::size_t count) {
     if (count == 1) {
       edges.boundary.push_back(key);
+      edges.boundary_triangle.push_back(first[0].triangle);
     } else if (count == 2 && with_neighbours) {
       addNeighbour(first[0].triangle, first[1].triangle);
       addNeighbour(first[1].triangle, first[0].triangle);
     }
   });
   return edges;
+}
+
+void addFilling(MeshEdges &edges, const std::vector<Triangle> &triangles, std::size_t first_new) {
+  struct Use {
+    EdgeKey key;
+    std::uint32_t triangle;
+    bool operator<(const Use &other) const {
+      return key < other.key || (key == other.key && triangle < other.triangle);
+    }
+  };
+  std::vector<Use> uses;
+  for (std::size_t t = first_new; t < triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k)
+      uses.push_back(
+          {edgeKey(triangles[t][k], triangles[t][(k + 1) % 3]), static_cast<std::uint32_t>(t)});
+  std::sort(uses.begin(), uses.end());
+  edges.neighbours.resize(3 * triangles.size(), no_neighbour);
+  std::vector<std::uint32_t> relinked;
+  auto link = [&](std::uint32_t t, std::uint32_t u) {
+    std::uint32_t *slot = &edges.neighbours[3 * std::size_t{t}];
+    while (*slot != no_neighbour)
+      ++slot;
+    *slot = u;
+    relinked.push_back(t);
+  };
+  std::vector<bool> closed(edges.boundary.size(), false);
+  std::vector<std::pair<EdgeKey, std::uint32_t>> opened;
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i;
+    while (j < uses.size() && uses[j].key == uses[i].key)
+      ++j;
+    const auto at = std::lower_bound(edges.boundary.begin(), edges.boundary.end(), uses[i].key);
+    const bool was_boundary = at != edges.boundary.end() && *at == uses[i].key;
+    const std::size_t count = j - i + (was_boundary ? 1 : 0);
+    std::uint32_t first = uses[i].triangle;
+    if (was_boundary) {
+      const std::size_t index = static_cast<std::size_t>(at - edges.boundary.begin());
+      closed[index] = true;
+      first = edges.boundary_triangle[index];
+    }
+    if (count == 2) {
+      link(first, uses[j - 1].triangle);
+      link(uses[j - 1].triangle, first);
+    } else if (count == 1) {
+      opened.emplace_back(uses[i].key, uses[i].triangle);
+    } // three or more: not manifold, no neighbours
+    i = j;
+  }
+  // Each relinked triangle's slots back in the order of the edges' keys.
+  std::sort(relinked.begin(), relinked.end());
+  relinked.erase(std::unique(relinked.begin(), relinked.end()), relinked.end());
+  for (std::uint32_t t : relinked) {
+    std::uint32_t *slots = &edges.neighbours[3 * std::size_t{t}];
+    std::array<std::pair<EdgeKey, std::uint32_t>, 3> by_key;
+    std::size_t count = 0;
+    for (; count < 3 && slots[count] != no_neighbour; ++count) {
+      const Triangle &mine = triangles[t], &theirs = triangles[slots[count]];
+      VertexIndex shared[2] = {0, 0};
+      int found = 0;
+      for (VertexIndex v : mine)
+        if (found < 2 && std::find(theirs.begin(), theirs.end(), v) != theirs.end())
+          shared[found++] = v;
+      by_key[count] = {edgeKey(shared[0], shared[1]), slots[count]};
+    }
+    std::sort(by_key.begin(), by_key.begin() + static_cast<std::ptrdiff_t>(count));
+    for (std::size_t k = 0; k < count; ++k)
+      slots[k] = by_key[k].second;
+  }
+  // The boundary without the closed edges, with the opened ones, in key order.
+  std::sort(opened.begin(), opened.end());
+  std::vector<EdgeKey> boundary;
+  std::vector<std::uint32_t> boundary_triangle;
+  auto next_opened = opened.begin();
+  for (std::size_t e = 0; e <= edges.boundary.size(); ++e) {
+    const bool last = e == edges.boundary.size();
+    for (; next_opened != opened.end() && (last || next_opened->first < edges.boundary[e]);
+         ++next_opened) {
+      boundary.push_back(next_opened->first);
+      boundary_triangle.push_back(next_opened->second);
+    }
+    if (!last && !closed[e]) {
+      boundary.push_back(edges.boundary[e]);
+      boundary_triangle.push_back(edges.boundary_triangle[e]);
+    }
+  }
+  edges.boundary = std::move(boundary);
+  edges.boundary_triangle = std::move(boundary_triangle);
 }
 
 std::vector<std::vector<VertexIndex>> boundaryLoops(const std::vector<EdgeKey> &boundary) {
@@ -156,6 +248,10 @@ namespace {
 constexpr int max_untwist_rounds = 3;
 // Loops opened by cutting twists are closed again up to this size.
 constexpr int max_untwist_loop_edges = 16;
+// Room kept for hole fillings: a 1M-point surface (2M triangles) takes
+// about 500 triangles in 100 holes.
+constexpr std::size_t fill_room_divisor = 256;
+constexpr std::size_t min_fill_room = 64;
 
 } // namespace
 
@@ -168,16 +264,30 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
                               const SideLimit &limit, const std::vector<bool> *anchored_vertices,
                               const Eigen::Vector3d *viewpoint) {
   FinishedSurface surface;
+  // Room for the fillings, so that they join the list while its neighbours
+  // are held: moving a 20M-triangle list then would add 240 MB to the peak.
+  triangles.reserve(triangles.size() + triangles.size() / fill_room_divisor + min_fill_room);
   auto fillThenOrient = [&](int max_edges, const std::vector<bool> *only_around) {
-    // Holes first, with only the boundary in hand: a filling grows the
-    // triangle list, which then briefly exists twice, so the neighbours (as
-    // large) are found after it.
-    surface.boundary_loops = detail::boundaryLoops(detail::meshEdges(triangles, false).boundary);
-    const std::size_t filled =
-        detail::fillLoops(triangles, surface.boundary_loops, points, max_edges, limit, only_around);
-    const detail::MeshEdges edges = detail::meshEdges(triangles, true);
-    if (filled > 0)
+    detail::MeshEdges edges = detail::meshEdges(triangles, true);
+    surface.boundary_loops = detail::boundaryLoops(edges.boundary);
+    std::vector<Triangle> filling;
+    const std::size_t filled = detail::fillLoops(triangles, surface.boundary_loops, points,
+                                                 max_edges, limit, only_around, filling);
+    if (filled > 0) {
+      const std::size_t first_new = triangles.size();
+      if (triangles.capacity() - first_new >= filling.size()) {
+        triangles.insert(triangles.end(), filling.begin(), filling.end());
+        detail::addFilling(edges, triangles, first_new);
+      } else {
+        // Out of room: the list moves, without the neighbours (as large)
+        // held meanwhile, and they are found again.
+        edges = detail::MeshEdges();
+        triangles.reserve(first_new + filling.size() + min_fill_room);
+        triangles.insert(triangles.end(), filling.begin(), filling.end());
+        edges = detail::meshEdges(triangles, true);
+      }
       surface.boundary_loops = detail::boundaryLoops(edges.boundary);
+    }
     surface.holes_filled += filled;
     return detail::orientAlongNeighbours(triangles, edges.neighbours, points,
                                          surface.triangle_component, surface.component_orientable,

@@ -38,10 +38,14 @@ inline constexpr std::uint32_t no_neighbour = 0xffffffffu;
 struct MeshEdges {
   /// Edges with one triangle, in key order.
   std::vector<EdgeKey> boundary;
+  /// The triangle of each boundary edge.
+  std::vector<std::uint32_t> boundary_triangle;
   /// Only when asked for: three slots per triangle holding the triangles
   /// across its manifold edges (edges with two triangles) in the order of
   /// those edges' keys, then no_neighbour. 12 bytes a triangle: at 10M
   /// points a list of pairs and each triangle's pairs took twice that.
+  /// Its capacity matches the triangle list's, so that addFilling can grow
+  /// it in place.
   std::vector<std::uint32_t> neighbours;
 };
 
@@ -52,6 +56,12 @@ struct MeshEdges {
 MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_neighbours,
                     std::size_t block_uses = std::size_t(1) << 24);
 
+/// Updates `edges` (with neighbours) of triangles[0, first_new) to cover
+/// the whole list, when the triangles from first_new on only close boundary
+/// edges and share new edges among themselves, as fillLoops' do: the same
+/// as meshEdges(triangles, true), without a scan of the whole list.
+void addFilling(MeshEdges &edges, const std::vector<Triangle> &triangles, std::size_t first_new);
+
 /// Cyclic boundary loops traced along boundary edges (sorted), each starting
 /// at its smallest vertex, in order of that vertex.
 std::vector<std::vector<VertexIndex>> boundaryLoops(const std::vector<EdgeKey> &boundary);
@@ -61,10 +71,14 @@ std::vector<std::vector<VertexIndex>> boundaryLoops(const std::vector<EdgeKey> &
 /// that the mesh already has inside the hole, sides below the limit except
 /// for a triangular hole), or any triangles when those cannot fill it
 /// (docs/algorithm.md, "Finishing"). Only simple loops; with only_around,
-/// only loops through a vertex marked there. Returns the holes closed.
-std::size_t fillLoops(std::vector<Triangle> &triangles, std::vector<std::vector<VertexIndex>> loops,
+/// only loops through a vertex marked there. Appends the new triangles to
+/// `added` (each of their edges is a boundary edge of `triangles` or a new
+/// edge of two of them) and returns the holes closed.
+std::size_t fillLoops(const std::vector<Triangle> &triangles,
+                      std::vector<std::vector<VertexIndex>> loops,
                       const std::vector<Eigen::Vector3d> &points, int max_edges,
-                      const SideLimit &limit, const std::vector<bool> *only_around);
+                      const SideLimit &limit, const std::vector<bool> *only_around,
+                      std::vector<Triangle> &added);
 
 /// orientComponents() given the mesh's manifold neighbours (MeshEdges).
 std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangles,

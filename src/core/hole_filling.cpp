@@ -122,9 +122,11 @@ std::vector<Triangle> triangulateLoop(const std::vector<VertexIndex> &loop,
 
 } // namespace
 
-std::size_t fillLoops(std::vector<Triangle> &triangles, std::vector<std::vector<VertexIndex>> loops,
+std::size_t fillLoops(const std::vector<Triangle> &triangles,
+                      std::vector<std::vector<VertexIndex>> loops,
                       const std::vector<Eigen::Vector3d> &points, int max_edges,
-                      const SideLimit &limit, const std::vector<bool> *only_around) {
+                      const SideLimit &limit, const std::vector<bool> *only_around,
+                      std::vector<Triangle> &added) {
   if (max_edges < 3)
     return 0;
   // Only simple loops: a vertex met twice is a pinch the polygon DP cannot
@@ -168,7 +170,6 @@ std::size_t fillLoops(std::vector<Triangle> &triangles, std::vector<std::vector<
     }
 
   std::size_t filled = 0;
-  std::vector<Triangle> added;
   for (const auto &loop : loops) {
     if (loop.size() < 3 || loop.size() > static_cast<std::size_t>(max_edges))
       continue;
@@ -194,10 +195,6 @@ std::size_t fillLoops(std::vector<Triangle> &triangles, std::vector<std::vector<
     added.insert(added.end(), filling.begin(), filling.end());
     ++filled;
   }
-  // Exactly the room needed: growing a 20M-triangle list by doubling would
-  // keep 240 MB unused through the rest of the finishing.
-  triangles.reserve(triangles.size() + added.size());
-  triangles.insert(triangles.end(), added.begin(), added.end());
   return filled;
 }
 
