@@ -5,6 +5,8 @@
 // are in hole_filling.cpp, orientation.cpp, bow_ties.cpp; this file drives them.
 #include "finish_steps.h"
 
+#include <tbb/parallel_reduce.h>
+
 #include <algorithm>
 #include <array>
 #include <utility>
@@ -23,24 +25,62 @@ struct EdgeUse {
   }
 };
 
-/// Calls visit(key, first, count) for each distinct edge in key order, with
-/// its `count` incidences at [first, first + count), sorted by triangle. A
-/// 20M-triangle surface has 60M incidences: holding them all beside the
-/// triangles, points and neighbours set the peak of a whole MPI run's rank 0
-/// (docs/algorithm.md, "Across processes"), so they are sorted in blocks.
-template <typename Visit>
-void forEachEdge(const std::vector<Triangle> &triangles, std::size_t block_uses, Visit &&visit) {
-  VertexIndex vertex_count = 0;
-  for (const Triangle &triangle : triangles)
-    for (VertexIndex v : triangle)
-      vertex_count = std::max(vertex_count, v + 1);
+/// Adds one to a count that other threads may add to as well.
+template <typename Count> Count countUp(Count &count) {
+  return __atomic_fetch_add(&count, Count{1}, __ATOMIC_RELAXED);
+}
+
+/// Where t's neighbour across `key` goes before the slots are packed: the
+/// edge's place among t's three edges in key order.
+std::size_t slotOf(const Triangle &t, EdgeKey key) {
+  std::size_t below = 0;
+  for (int k = 0; k < 3; ++k)
+    below += edgeKey(t[k], t[(k + 1) % 3]) < key;
+  return below;
+}
+
+} // namespace
+
+MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_neighbours,
+                    std::size_t block_uses) {
+  // Every (edge, triangle) incidence, filed under the edge's lower vertex and
+  // sorted there; each distinct edge then gives a boundary edge or a pair of
+  // neighbours. A 20M-triangle surface has 60M incidences: holding them all
+  // beside the triangles, points and neighbours set the peak of a whole MPI
+  // run's rank 0 (docs/algorithm.md, "Across processes"), so they are filed
+  // for a block of lower vertices at a time. Threads file them in any order
+  // and the sort settles it, so the result does not depend on the threads.
+  const std::size_t count = triangles.size();
+  const VertexIndex vertex_count = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, count, 1 << 12), VertexIndex{0},
+      [&](const tbb::blocked_range<std::size_t> &range, VertexIndex highest) {
+        for (std::size_t t = range.begin(); t != range.end(); ++t)
+          for (VertexIndex v : triangles[t])
+            highest = std::max(highest, v + 1);
+        return highest;
+      },
+      [](VertexIndex a, VertexIndex b) { return std::max(a, b); });
   // offsets[v]: the incidences filed under vertices below v.
   std::vector<std::uint64_t> offsets(static_cast<std::size_t>(vertex_count) + 1, 0);
-  for (const Triangle &triangle : triangles)
+  forEachIndex(count, [&](std::size_t t) {
     for (int k = 0; k < 3; ++k)
-      ++offsets[lowVertex(edgeKey(triangle[k], triangle[(k + 1) % 3])) + 1];
+      countUp(offsets[lowVertex(edgeKey(triangles[t][k], triangles[t][(k + 1) % 3])) + 1]);
+  });
   for (std::size_t v = 0; v < vertex_count; ++v)
     offsets[v + 1] += offsets[v];
+
+  MeshEdges edges;
+  if (with_neighbours) {
+    edges.neighbours.reserve(3 * triangles.capacity());
+    edges.neighbours.assign(3 * count, no_neighbour);
+  }
+  // A block's lower vertices in parts, each part's boundary edges found apart.
+  constexpr std::size_t parts_per_block = 64;
+  struct Boundary {
+    std::vector<EdgeKey> keys;
+    std::vector<std::uint32_t> triangles;
+  };
+  std::vector<Boundary> parts(parts_per_block);
   std::vector<EdgeUse> uses;
   uses.reserve(std::min<std::uint64_t>(block_uses, offsets[vertex_count])); // no regrowth
   std::vector<std::uint32_t> cursor;
@@ -53,56 +93,63 @@ void forEachEdge(const std::vector<Triangle> &triangles, std::size_t block_uses,
     cursor.resize(end - begin);
     for (VertexIndex v = begin; v < end; ++v)
       cursor[v - begin] = static_cast<std::uint32_t>(offsets[v] - base);
-    for (std::uint32_t t = 0; t < triangles.size(); ++t)
+    forEachIndex(count, [&](std::size_t t) {
       for (int k = 0; k < 3; ++k) {
         const EdgeKey key = edgeKey(triangles[t][k], triangles[t][(k + 1) % 3]);
         const VertexIndex low = lowVertex(key);
         if (low >= begin && low < end)
-          uses[cursor[low - begin]++] = {highVertex(key), t};
+          uses[countUp(cursor[low - begin])] = {highVertex(key), static_cast<std::uint32_t>(t)};
       }
-    forEachIndex(end - begin, [&](std::size_t i) {
+    });
+    const std::size_t block_vertices = end - begin;
+    forEachIndex(block_vertices, [&](std::size_t i) {
       std::sort(uses.begin() + static_cast<std::ptrdiff_t>(offsets[begin + i] - base),
                 uses.begin() + static_cast<std::ptrdiff_t>(offsets[begin + i + 1] - base));
     });
-    for (VertexIndex low = begin; low < end; ++low) {
-      const std::size_t last = offsets[low + 1] - base;
-      for (std::size_t i = offsets[low] - base; i < last;) {
-        std::size_t j = i;
-        while (j < last && uses[j].high == uses[i].high)
-          ++j;
-        visit(edgeKey(low, uses[i].high), &uses[i], j - i);
-        i = j;
+    tbb::parallel_for(std::size_t(0), parts_per_block, [&](std::size_t part) {
+      Boundary &boundary = parts[part];
+      boundary.keys.clear();
+      boundary.triangles.clear();
+      const VertexIndex first_low = static_cast<VertexIndex>(begin + block_vertices * part /
+                                                                         parts_per_block),
+                        last_low = static_cast<VertexIndex>(begin + block_vertices * (part + 1) /
+                                                                        parts_per_block);
+      for (VertexIndex low = first_low; low < last_low; ++low) {
+        const std::size_t last = offsets[low + 1] - base;
+        for (std::size_t i = offsets[low] - base; i < last;) {
+          std::size_t j = i;
+          while (j < last && uses[j].high == uses[i].high)
+            ++j;
+          const EdgeKey key = edgeKey(low, uses[i].high);
+          if (j - i == 1) {
+            boundary.keys.push_back(key);
+            boundary.triangles.push_back(uses[i].triangle);
+          } else if (j - i == 2 && with_neighbours) {
+            const std::uint32_t t = uses[i].triangle, u = uses[i + 1].triangle;
+            edges.neighbours[3 * std::size_t{t} + slotOf(triangles[t], key)] = u;
+            edges.neighbours[3 * std::size_t{u} + slotOf(triangles[u], key)] = t;
+          }
+          i = j;
+        }
       }
+    });
+    for (const Boundary &boundary : parts) {
+      edges.boundary.insert(edges.boundary.end(), boundary.keys.begin(), boundary.keys.end());
+      edges.boundary_triangle.insert(edges.boundary_triangle.end(), boundary.triangles.begin(),
+                                     boundary.triangles.end());
     }
     begin = end;
   }
-}
-
-} // namespace
-
-MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_neighbours,
-                    std::size_t block_uses) {
-  MeshEdges edges;
-  if (with_neighbours) {
-    edges.neighbours.reserve(3 * triangles.capacity());
-    edges.neighbours.assign(3 * triangles.size(), no_neighbour);
-  }
-  // Edges come in key order, so each triangle's slots fill in that order.
-  auto addNeighbour = [&](std::uint32_t t, std::uint32_t u) {
-    std::uint32_t *slot = &edges.neighbours[3 * std::size_t{t}];
-    while (*slot != no_neighbour) // a triangle has three edges: a slot is free
-      ++slot;
-    *slot = u;
-  };
-  forEachEdge(triangles, block_uses, [&](EdgeKey key, const EdgeUse *first, std::size_t count) {
-    if (count == 1) {
-      edges.boundary.push_back(key);
-      edges.boundary_triangle.push_back(first[0].triangle);
-    } else if (count == 2 && with_neighbours) {
-      addNeighbour(first[0].triangle, first[1].triangle);
-      addNeighbour(first[1].triangle, first[0].triangle);
-    }
-  });
+  // Each triangle's neighbours first, still in the order of the edges' keys.
+  if (with_neighbours)
+    forEachIndex(count, [&](std::size_t t) {
+      std::uint32_t *slots = &edges.neighbours[3 * t];
+      std::size_t kept = 0;
+      for (std::size_t k = 0; k < 3; ++k)
+        if (slots[k] != no_neighbour)
+          slots[kept++] = slots[k];
+      std::fill(slots + kept, slots + 3, no_neighbour);
+    });
   return edges;
 }
 
