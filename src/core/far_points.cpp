@@ -3,6 +3,8 @@
 // points far from the rest, and a centre they cannot move.
 #include "far_points.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -30,8 +32,9 @@ FarPoints findFarPoints(const std::vector<Eigen::Vector3f> &points) {
   const std::size_t n = points.size();
   const auto tail = static_cast<std::size_t>(tail_fraction * static_cast<double>(n));
   Eigen::Vector3d central_low, central_high;
-  std::vector<float> values(n);
-  for (int axis = 0; axis < 3; ++axis) {
+  // The axes are independent selections: one thread each.
+  tbb::parallel_for(0, 3, [&](int axis) {
+    std::vector<float> values(n);
     for (std::size_t i = 0; i < n; ++i)
       values[i] = points[i][axis];
     auto at = [&](std::size_t k) {
@@ -41,7 +44,7 @@ FarPoints findFarPoints(const std::vector<Eigen::Vector3f> &points) {
     };
     central_low[axis] = at(tail);
     central_high[axis] = at(n - 1 - tail);
-  }
+  });
   const double size = (central_high - central_low).norm();
 
   // Only points beyond `size` from the central box can be within `size` of a
@@ -78,16 +81,16 @@ FarPoints findFarPoints(const std::vector<Eigen::Vector3f> &points) {
   }
 
   // The median of the points kept, so that far points change nothing.
-  values.clear();
-  for (int axis = 0; axis < 3; ++axis) {
-    values.clear();
+  tbb::parallel_for(0, 3, [&](int axis) {
+    std::vector<float> values;
+    values.reserve(n - far.count);
     for (std::size_t i = 0; i < n; ++i)
       if (!far.is_far[i])
         values.push_back(points[i][axis]);
     auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
     std::nth_element(values.begin(), middle, values.end());
     far.median[axis] = *middle;
-  }
+  });
   far.low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   far.high = -far.low;
   for (std::size_t i = 0; i < n; ++i)

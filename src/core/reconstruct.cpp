@@ -13,6 +13,8 @@
 #include "morton.h"
 #include "threads.h"
 
+#include <tbb/parallel_sort.h>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -201,13 +203,17 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
   }
   records.clear();
   records.shrink_to_fit();
-  std::sort(keys.begin(), keys.end());
+  tbb::parallel_sort(keys.begin(), keys.end()); // keys are distinct: one order
 
   PreparedPoints prepared;
   if (map_records)
     prepared.prepared_of_record.assign(view.size, not_prepared);
   const Eigen::Vector3d &centre = far.median;
   prepared.centre = centre;
+  prepared.positions.reserve(keys.size());
+  prepared.user_index.reserve(keys.size());
+  if (with_normals)
+    prepared.normals.reserve(keys.size());
   for (std::size_t i = 0; i < keys.size(); ++i) {
     const Key &key = keys[i];
     if (i > 0 && key.coordinates == keys[i - 1].coordinates) {
@@ -370,8 +376,9 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
   const Deadline deadline(parameters.time_limit_seconds);
   Result result;
   Clock::time_point stage = Clock::now();
-  const PreparedPoints prepared =
-      preparePoints(points, parameters.use_normals, !initial_triangles.empty(), result);
+  const PreparedPoints prepared = detail::threadArena(parameters.num_threads).execute([&] {
+    return preparePoints(points, parameters.use_normals, !initial_triangles.empty(), result);
+  });
   result.timings.prepare = secondsSince(stage);
   result.peak_memory.prepare = peakResidentBytes();
   exchange.pointsPrepared(); // `points` is not read below
