@@ -44,6 +44,10 @@ bool runsFromTo(const Triangle &t, VertexIndex a, VertexIndex b) {
 // same orientation, this one leaves few edges to sort on a smooth surface.
 constexpr double kruskal_flat_bending = 0.5;
 
+// How far ahead the breadth-first walk fetches: slots, then what they point to.
+constexpr std::size_t walk_prefetch_far = 16;
+constexpr std::size_t walk_prefetch_near = 8;
+
 /// The shared edge of two neighbouring triangles, as its key.
 EdgeKey sharedEdge(const Triangle &first, const Triangle &second) {
   VertexIndex shared[2] = {0, 0};
@@ -156,6 +160,15 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
     triangle_component[seed] = component;
     std::vector<std::uint32_t> &queue = members.back();
     for (std::size_t head = 0; head < queue.size(); ++head) {
+      // The walk jumps through memory: fetch the slots of the triangle 16
+      // places ahead, and what the one 8 places ahead will read next.
+      if (head + walk_prefetch_far < queue.size())
+        __builtin_prefetch(&neighbours[3 * std::size_t{queue[head + walk_prefetch_far]}]);
+      if (head + walk_prefetch_near < queue.size())
+        for (std::uint32_t u : neighboursOf(neighbours, queue[head + walk_prefetch_near])) {
+          __builtin_prefetch(&triangle_component[u]);
+          __builtin_prefetch(&triangles[u]);
+        }
       const std::uint32_t t = queue[head];
       for (std::uint32_t u : neighboursOf(neighbours, t))
         if (triangle_component[u] == unvisited)
@@ -226,6 +239,12 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
         });
         for (std::size_t i = 0; i < count; ++i) {
           const std::uint32_t t = static_cast<std::uint32_t>(first + i);
+          // The joins read the neighbours' forest entries and corners.
+          if (i + walk_prefetch_near < count)
+            forEachEdgeOf(t + walk_prefetch_near, [&](std::uint32_t u) {
+              forest.prefetch(u);
+              __builtin_prefetch(&triangles[u]);
+            });
           if (!inTwistedComponent(t))
             continue;
           std::size_t slot = 3 * i;
@@ -331,7 +350,17 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
     // there is one (area-weighted); a fixed, reproducible choice otherwise.
     double signed_volume = 0, facing = 0;
     bool closed = true;
-    for (std::uint32_t t : members[component]) {
+    const std::vector<std::uint32_t> &walked = members[component];
+    for (std::size_t i = 0; i < walked.size(); ++i) {
+      // Walk order jumps through memory, as above.
+      if (i + walk_prefetch_far < walked.size()) {
+        __builtin_prefetch(&triangles[walked[i + walk_prefetch_far]]);
+        __builtin_prefetch(&neighbours[3 * std::size_t{walked[i + walk_prefetch_far]}]);
+      }
+      if (i + walk_prefetch_near < walked.size())
+        for (VertexIndex v : triangles[walked[i + walk_prefetch_near]])
+          __builtin_prefetch(&points[v]);
+      const std::uint32_t t = walked[i];
       const Eigen::Vector3d &a = points[triangles[t][0]], &b = points[triangles[t][1]],
                             &c = points[triangles[t][2]];
       signed_volume += a.dot(b.cross(c));
