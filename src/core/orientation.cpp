@@ -93,41 +93,65 @@ bool consistentlyOriented(const Triangle &t, const Triangle &u) {
   return false;
 }
 
-/// Whether a walk of at most max_steps triangles from `start` across
+/// Whether a walk of at most max_steps triangles from a triangle across
 /// manifold edges returns to it with its orientation reversed (crossing an
-/// edge whose triangles disagree reverses it): breadth first over
-/// (triangle, reversed) states. `reached` has one entry per triangle, all 0
-/// (bit 0: reached as it is, bit 1: reversed), and is left so.
-bool reversesWithin(std::uint32_t start, int max_steps, const std::vector<Triangle> &triangles,
-                    const std::vector<std::uint32_t> &neighbours,
-                    std::vector<std::uint8_t> &reached) {
-  using State = std::pair<std::uint32_t, bool>;
-  std::vector<State> frontier = {{start, false}}, next;
-  std::vector<std::uint32_t> touched = {start};
-  reached[start] = 1;
-  bool reverses = false;
-  for (int step = 0; step < max_steps && !frontier.empty() && !reverses; ++step) {
-    next.clear();
-    for (const auto &[t, reversed] : frontier)
-      for (std::uint32_t u : neighboursOf(neighbours, t)) {
+/// edge whose triangles disagree reverses it). Breadth first over
+/// (triangle, reversed) states, to half that depth: a reversing walk of
+/// length L passes a state at depth ceil(L / 2) whose mirror image (the same
+/// triangle the other way) is at depth L - ceil(L / 2), so the search stops
+/// at a triangle reached both ways at depths adding up to max_steps or less.
+/// Keeps its buffers from one search to the next.
+class TwistWalk {
+public:
+  explicit TwistWalk(std::size_t triangle_count) : reached_(triangle_count, 0) {}
+
+  bool reversesWithin(std::uint32_t start, int max_steps, const std::vector<Triangle> &triangles,
+                      const std::vector<std::uint32_t> &neighbours) {
+    frontier_.assign(1, {start, false});
+    touched_.assign(1, start);
+    reached_[start] = as_it_is; // at depth 0
+    bool reverses = false;
+    const int half = (max_steps + 1) / 2;
+    for (int step = 0; step < half && !frontier_.empty() && !reverses; ++step) {
+      const std::uint32_t depth = static_cast<std::uint32_t>(step) + 1;
+      next_.clear();
+      for (const auto &[t, reversed] : frontier_) {
+        for (std::uint32_t u : neighboursOf(neighbours, t)) {
+          const bool u_reversed = reversed == consistentlyOriented(triangles[t], triangles[u]);
+          const std::uint32_t way = u_reversed ? the_other_way : as_it_is;
+          std::uint32_t &entry = reached_[u];
+          if (entry & way)
+            continue;
+          if (entry == 0) {
+            touched_.push_back(u);
+            entry = depth << 2 | way;
+          } else {
+            // Reached the other way first, at depth (entry >> 2) <= depth.
+            entry |= way;
+            reverses = depth + (entry >> 2) <= static_cast<std::uint32_t>(max_steps);
+            if (reverses)
+              break;
+          }
+          next_.push_back({u, u_reversed});
+        }
         if (reverses)
           break;
-        const State state{u, reversed == consistentlyOriented(triangles[t], triangles[u])};
-        reverses = state.first == start && state.second;
-        const std::uint8_t bit = state.second ? 2 : 1;
-        if (reached[state.first] & bit)
-          continue;
-        if (reached[state.first] == 0)
-          touched.push_back(state.first);
-        reached[state.first] |= bit;
-        next.push_back(state);
       }
-    frontier.swap(next);
+      frontier_.swap(next_);
+    }
+    for (std::uint32_t t : touched_)
+      reached_[t] = 0;
+    return reverses;
   }
-  for (std::uint32_t t : touched)
-    reached[t] = 0;
-  return reverses;
-}
+
+private:
+  static constexpr std::uint32_t as_it_is = 1, the_other_way = 2;
+  /// Per triangle: 0, or the depth it was first reached at (shifted by 2)
+  /// and the ways it was reached.
+  std::vector<std::uint32_t> reached_;
+  std::vector<std::pair<std::uint32_t, bool>> frontier_, next_;
+  std::vector<std::uint32_t> touched_;
+};
 
 } // namespace
 
@@ -318,7 +342,7 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
       };
       return facing(t) < facing(u) ? t : u;
     };
-    std::vector<std::uint8_t> reached(triangles.size(), 0);
+    TwistWalk walk(triangles.size());
     std::vector<bool> holds_real_twist(members.size(), false);
     for (const Conflict &conflict : conflicts) {
       const std::uint32_t t = conflict.t, u = conflict.u;
@@ -326,11 +350,11 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
       const int long_walk = static_cast<int>(
           max_twist_steps_per_root * std::sqrt(static_cast<double>(members[component].size())));
       auto localTwist = [&]() {
-        if (reversesWithin(t, max_local_twist_steps, triangles, neighbours, reached))
+        if (walk.reversesWithin(t, max_local_twist_steps, triangles, neighbours))
           return true;
         if (holds_real_twist[component] || long_walk <= max_local_twist_steps)
           return false;
-        if (reversesWithin(t, long_walk, triangles, neighbours, reached))
+        if (walk.reversesWithin(t, long_walk, triangles, neighbours))
           return true;
         holds_real_twist[component] = true;
         return false;

@@ -627,6 +627,25 @@ TEST(Finish, GentleMoebiusBandIsKeptWhole) {
   EXPECT_EQ(surface.boundary_loops.size(), 1u);
 }
 
+TEST(Finish, TwistIsLocalUpToThirtyTwoTriangles) {
+  // A band of 2n triangles reverses orientation only all the way round, a
+  // walk of exactly 2n triangles; its edges bend by less than 90 degrees.
+  // A walk of up to 32 triangles makes the twist local (cut); 34 does not,
+  // and 2 sqrt(34) allows no longer walk.
+  for (const int segments : {15, 16, 17}) {
+    SCOPED_TRACE(segments);
+    std::vector<Eigen::Vector3d> points;
+    std::vector<Triangle> band;
+    moebiusBand(segments, 0.2, points, band);
+    const std::vector<float> unit_scale(points.size(), 1.0f);
+    const FinishedSurface surface = finishSurface(band, points, 0, SideLimit{&unit_scale, 10.0});
+    if (segments <= 16)
+      EXPECT_GT(surface.twist_triangles_removed, 0u);
+    else
+      EXPECT_EQ(surface.twist_triangles_removed, 0u);
+  }
+}
+
 TEST(Finish, SameSurfaceForAnyNumberOfThreads) {
   // Long enough for the parallel loops to split the work; non-orientable,
   // so the spanning-forest orientation runs as well.
