@@ -549,6 +549,47 @@ TEST(Finish, FillingUpdateMatchesANewEdgeScan) {
   EXPECT_FALSE(scanned.boundary.empty());
 }
 
+// Finishing keeps room for the fillings beside the triangle list (1/256 of
+// it plus 64); more fillings move the list and scan it again. Either way
+// the surface is the list with its fillings, oriented, loops traced anew:
+// the bunny's reference mesh with every 997th triangle taken out (70 holes,
+// within the room) and every 97th (over 300, beyond it).
+TEST(Finish, FillingsWithinAndBeyondTheRoomGiveTheFilledSurface) {
+  const pcl_ms_test::ReferenceMesh &bunny = pcl_ms_test::bunnyReference();
+  const std::vector<float> scale(bunny.vertices.size(), 0.002f);
+  const SideLimit limit{&scale, 5.0};
+  for (const std::size_t every : {std::size_t(997), std::size_t(97)}) {
+    SCOPED_TRACE(every);
+    std::vector<Triangle> holed;
+    for (std::size_t t = 0; t < bunny.triangles.size(); ++t)
+      if (t % every != 0)
+        holed.push_back(bunny.triangles[t]);
+    std::vector<Triangle> filling;
+    const std::size_t filled = detail::fillLoops(holed, traceBoundaryLoops(holed), bunny.vertices,
+                                                 9, limit, nullptr, filling);
+    const bool beyond = filling.size() > holed.size() / 256 + 64;
+    EXPECT_EQ(beyond, every == 97) << filling.size() << " filling triangles";
+
+    const FinishedSurface surface = finishSurface(holed, bunny.vertices, 9, limit);
+    EXPECT_EQ(surface.holes_filled, filled);
+    EXPECT_EQ(surface.twist_triangles_removed, 0u);
+    std::vector<Triangle> expected = holed;
+    expected.insert(expected.end(), filling.begin(), filling.end());
+    auto corners = [](std::vector<Triangle> triangles) {
+      for (Triangle &triangle : triangles)
+        std::sort(triangle.begin(), triangle.end());
+      std::sort(triangles.begin(), triangles.end());
+      return triangles;
+    };
+    EXPECT_EQ(corners(surface.triangles), corners(expected));
+    EXPECT_EQ(surface.boundary_loops, traceBoundaryLoops(surface.triangles));
+    // Holes that touch at a corner stay open and pinch it; edges stay manifold.
+    const MeshTopologyReport report = analyzeMesh(bunny.vertices, surface.triangles);
+    EXPECT_EQ(report.non_manifold_edges, 0u);
+    EXPECT_EQ(report.inconsistently_oriented_edges, 0u);
+  }
+}
+
 TEST(Finish, FillsTheMissingFaceOfACube) {
   const std::vector<Eigen::Vector3d> corners = cubeCorners();
   // The cube's faces as two triangles each, the top (z = 1) left out.
