@@ -91,9 +91,12 @@ std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_co
                          std::vector<bool> &touched) {
   const std::size_t before = triangles.size();
   touched.resize(vertex_count, false);
+  // After the first round only the corners of what it removed can have
+  // gained a second fan: the other vertices kept their triangles.
+  std::vector<bool> check = touched;
   for (bool changed = true; changed;) {
     changed = false;
-    const detail::MarkedIncidence incidence(triangles, touched);
+    const detail::MarkedIncidence incidence(triangles, check);
     std::vector<bool> drop(triangles.size(), false);
     for (std::size_t slot = 0; slot < incidence.vertices().size(); ++slot) {
       const VertexIndex v = incidence.vertices()[slot];
@@ -112,8 +115,13 @@ std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_co
           for (std::uint32_t t : fans[f])
             drop[t] = changed = true;
     }
-    if (changed)
-      detail::dropTriangles(triangles, drop, touched);
+    if (changed) {
+      std::fill(check.begin(), check.end(), false);
+      detail::dropTriangles(triangles, drop, check);
+      for (VertexIndex v = 0; v < check.size(); ++v)
+        if (check[v])
+          touched[v] = true;
+    }
   }
   return before - triangles.size();
 }
