@@ -310,12 +310,31 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
       bool operator<(const Conflict &other) const { return key < other.key; }
     };
     std::vector<Conflict> conflicts;
-    for (std::uint32_t t = 0; t < triangles.size(); ++t)
-      if (inTwistedComponent(t))
+    {
+      // Found in parallel (bit k: t's k-th edge to a later triangle), listed in order.
+      std::vector<std::uint8_t> inconsistent(triangles.size(), 0);
+      forEachIndex(triangles.size(), [&](std::size_t i) {
+        const std::uint32_t t = static_cast<std::uint32_t>(i);
+        if (!inTwistedComponent(t))
+          return;
+        std::uint8_t edge = 1;
         forEachEdgeOf(t, [&](std::uint32_t u) {
           if (!consistentlyOriented(triangles[t], triangles[u]))
-            conflicts.push_back({sharedEdge(triangles[t], triangles[u]), t, u});
+            inconsistent[t] |= edge;
+          edge = static_cast<std::uint8_t>(edge << 1);
         });
+      });
+      for (std::uint32_t t = 0; t < triangles.size(); ++t) {
+        if (!inconsistent[t])
+          continue;
+        std::uint8_t edge = 1;
+        forEachEdgeOf(t, [&](std::uint32_t u) {
+          if (inconsistent[t] & edge)
+            conflicts.push_back({sharedEdge(triangles[t], triangles[u]), t, u});
+          edge = static_cast<std::uint8_t>(edge << 1);
+        });
+      }
+    }
     std::sort(conflicts.begin(), conflicts.end());
     // A conflict is repaired where the surface folds sharply, or where the
     // twist it closes is local: an orientation-reversing walk that is short
