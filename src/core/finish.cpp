@@ -207,13 +207,7 @@ void addFilling(MeshEdges &edges, const std::vector<Triangle> &triangles, std::s
     std::array<std::pair<EdgeKey, std::uint32_t>, 3> by_key;
     std::size_t count = 0;
     for (; count < 3 && slots[count] != no_neighbour; ++count) {
-      const Triangle &mine = triangles[t], &theirs = triangles[slots[count]];
-      VertexIndex shared[2] = {0, 0};
-      int found = 0;
-      for (VertexIndex v : mine)
-        if (found < 2 && std::find(theirs.begin(), theirs.end(), v) != theirs.end())
-          shared[found++] = v;
-      by_key[count] = {edgeKey(shared[0], shared[1]), slots[count]};
+      by_key[count] = {sharedEdge(triangles[t], triangles[slots[count]]), slots[count]};
     }
     std::sort(by_key.begin(), by_key.begin() + static_cast<std::ptrdiff_t>(count));
     for (std::size_t k = 0; k < count; ++k)

@@ -34,6 +34,16 @@ template <typename Work> void forEachIndex(std::size_t count, const Work &work) 
 
 inline constexpr std::uint32_t no_neighbour = 0xffffffffu;
 
+/// The edge that two neighbouring triangles share, as its key.
+inline EdgeKey sharedEdge(const Triangle &first, const Triangle &second) {
+  VertexIndex shared[2] = {0, 0};
+  int found = 0;
+  for (VertexIndex v : first)
+    if ((v == second[0] || v == second[1] || v == second[2]) && found < 2)
+      shared[found++] = v;
+  return edgeKey(shared[0], shared[1]);
+}
+
 /// What one scan of a triangle list's edges finds.
 struct MeshEdges {
   /// Edges with one triangle, in key order.

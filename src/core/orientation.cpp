@@ -48,16 +48,6 @@ constexpr double kruskal_flat_bending = 0.5;
 constexpr std::size_t walk_prefetch_far = 16;
 constexpr std::size_t walk_prefetch_near = 8;
 
-/// The shared edge of two neighbouring triangles, as its key.
-EdgeKey sharedEdge(const Triangle &first, const Triangle &second) {
-  VertexIndex shared[2] = {0, 0};
-  int found = 0;
-  for (VertexIndex v : first)
-    if ((v == second[0] || v == second[1] || v == second[2]) && found < 2)
-      shared[found++] = v;
-  return edgeKey(shared[0], shared[1]);
-}
-
 /// How much the surface bends across the edge that t and u share.
 double bendingAt(std::uint32_t t, std::uint32_t u, const std::vector<Triangle> &triangles,
                  const std::vector<Eigen::Vector3d> &points) {
