@@ -90,7 +90,6 @@ public:
       }
       grid_low_ = low;
       grid_cell_ = ((high - low) / grid).cwiseMax(Eigen::Vector3d::Constant(1e-300));
-      grid_ = grid;
       root_ = buildGrid(order, 0, order.size(), Box(), {0, 0, 0}, {grid, grid, grid}, 0);
     } else {
       root_ = buildMedian(order, 0, order.size(), Box(), bucket_points, 0);
@@ -185,11 +184,6 @@ private:
     return makeInner(region, axis, split, depth, left, right);
   }
 
-  int gridCell(const Eigen::Vector3d &p, int axis) const {
-    const int cell = static_cast<int>(std::floor((p[axis] - grid_low_[axis]) / grid_cell_[axis]));
-    return std::clamp(cell, 0, grid_ - 1);
-  }
-
   /// Splits the grid's cell range in halves, so the grid becomes a tree too.
   int buildGrid(std::vector<VertexIndex> &order, std::size_t begin, std::size_t end,
                 const Box &region, std::array<int, 3> first, std::array<int, 3> last, int depth) {
@@ -202,12 +196,14 @@ private:
     if (last[axis] - first[axis] <= 1)
       return makeLeaf(order, begin, end, region, depth);
     const int middle_cell = (first[axis] + last[axis]) / 2;
-    const auto middle =
-        std::stable_partition(order.begin() + begin, order.begin() + end, [&](VertexIndex v) {
-          return gridCell(points_[v], axis) < middle_cell;
-        });
-    const std::size_t middle_index = static_cast<std::size_t>(middle - order.begin());
     const double split = grid_low_[axis] + middle_cell * grid_cell_[axis];
+    // Sides by the plane itself, so every point lies in its leaf's region:
+    // a cell number computed as floor((p - low) / cell) can round across
+    // the plane when coordinates span many orders of magnitude.
+    const auto middle =
+        std::stable_partition(order.begin() + begin, order.begin() + end,
+                              [&](VertexIndex v) { return points_[v][axis] < split; });
+    const std::size_t middle_index = static_cast<std::size_t>(middle - order.begin());
     Box left_region = region, right_region = region;
     left_region.high[axis] = split;
     right_region.low[axis] = split;
@@ -250,7 +246,6 @@ private:
   std::vector<std::uint32_t> leaf_of_;
   int root_ = -1;
   Eigen::Vector3d grid_low_ = Eigen::Vector3d::Zero(), grid_cell_ = Eigen::Vector3d::Ones();
-  int grid_ = 0;
 };
 
 /// For each bucket, the median nearest-neighbour distance from a few of its
