@@ -6,9 +6,12 @@
 
 #include <pcl_ms/io.h>
 
-// The reconstruct target's entry point and its promises, checked as they are
-// while fuzzing (a broken promise aborts).
+// The reconstruct targets' bodies and their promises, checked as they are
+// while fuzzing (a broken promise aborts). fuzz_reconstruct_inputs's body is
+// called by name: both targets' entry points have libFuzzer's one name.
 #include "fuzz/reconstruct_fuzzer.cpp"
+#define PCL_MS_FUZZ_REPLAY
+#include "fuzz/reconstruct_inputs_fuzzer.cpp"
 
 #include <gtest/gtest.h>
 
@@ -39,6 +42,17 @@ TEST(FuzzCorpus, ReconstructRunsEveryInputToAMeshOrAnError) {
     const std::string bytes = readFile(file.string());
     EXPECT_NO_THROW(
         LLVMFuzzerTestOneInput(reinterpret_cast<const std::uint8_t *>(bytes.data()), bytes.size()));
+  }
+}
+
+TEST(FuzzCorpus, ReconstructWithEveryOptionalInputRunsToAMeshOrAnError) {
+  const std::vector<fs::path> files = corpusFiles("reconstruct_inputs");
+  ASSERT_FALSE(files.empty());
+  for (const fs::path &file : files) {
+    SCOPED_TRACE(file.filename().string());
+    const std::string bytes = readFile(file.string());
+    EXPECT_NO_THROW(pcl_ms_fuzz::reconstructInputsOneInput(
+        reinterpret_cast<const std::uint8_t *>(bytes.data()), bytes.size()));
   }
 }
 

@@ -4,94 +4,15 @@
 // floats (NaN, Inf, denormals), grids, co-spherical points, duplicates and
 // huge or tiny magnitudes, meshed in one piece or in buckets. A run must end
 // with a 2-manifold mesh over valid records or a ReconstructionError.
-#include <pcl_ms/mesh_quality.h>
+#include "fuzz_clouds.h"
+
 #include <pcl_ms/reconstruct.h>
 
-#include <algorithm>
-#include <cmath>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <vector>
 
-namespace {
-
-constexpr std::size_t max_points = 96;
-
-/// Reads the fuzzer's bytes front to back; zeros once they run out.
-class ByteReader {
-public:
-  ByteReader(const std::uint8_t *data, std::size_t size) : data_(data), size_(size) {}
-  std::uint8_t byte() { return position_ < size_ ? data_[position_++] : 0; }
-  float rawFloat() {
-    std::uint8_t bytes[4] = {byte(), byte(), byte(), byte()};
-    float value;
-    std::memcpy(&value, bytes, sizeof value);
-    return value;
-  }
-  /// In [-1, 1] in steps of 1/127.
-  float unit() { return (static_cast<int>(byte()) - 128) / 127.0f; }
-  bool empty() const { return position_ >= size_; }
-
-private:
-  const std::uint8_t *data_;
-  std::size_t size_;
-  std::size_t position_ = 0;
-};
-
-void addPoint(std::vector<float> &xyz, float x, float y, float z) {
-  if (xyz.size() < 3 * max_points)
-    xyz.insert(xyz.end(), {x, y, z});
-}
-
-std::vector<float> buildCloud(ByteReader &bytes) {
-  std::vector<float> xyz;
-  const int shape = bytes.byte() % 5;
-  if (shape == 0) { // raw floats: every bit pattern, NaN and Inf included
-    while (!bytes.empty())
-      addPoint(xyz, bytes.rawFloat(), bytes.rawFloat(), bytes.rawFloat());
-  } else if (shape == 1) { // a regular grid, possibly flat or a line
-    const int nx = 1 + bytes.byte() % 5, ny = 1 + bytes.byte() % 5, nz = 1 + bytes.byte() % 4;
-    const float step = std::ldexp(1.0f, static_cast<int>(bytes.byte() % 64) - 32);
-    for (int i = 0; i < nx; ++i)
-      for (int j = 0; j < ny; ++j)
-        for (int k = 0; k < nz; ++k)
-          addPoint(xyz, i * step, j * step, k * step);
-  } else if (shape == 2) { // on one sphere: co-spherical within float rounding
-    const float radius = std::ldexp(1.0f, static_cast<int>(bytes.byte() % 80) - 40);
-    while (!bytes.empty()) {
-      const float theta = bytes.byte() * 0.0246f, phi = bytes.byte() * 0.0123f;
-      addPoint(xyz, radius * std::sin(phi) * std::cos(theta),
-               radius * std::sin(phi) * std::sin(theta), radius * std::cos(phi));
-    }
-  } else if (shape == 3) { // a few points, each repeated
-    std::vector<float> base;
-    const int count = 1 + bytes.byte() % 8;
-    for (int i = 0; i < 3 * count; ++i)
-      base.push_back(bytes.unit());
-    while (!bytes.empty()) {
-      const int i = bytes.byte() % count;
-      addPoint(xyz, base[3 * i], base[3 * i + 1], base[3 * i + 2]);
-    }
-  } else { // small coordinates times wildly different powers of two
-    while (!bytes.empty()) {
-      const float scale = std::ldexp(1.0f, static_cast<int>(bytes.byte() % 250) - 125);
-      addPoint(xyz, bytes.unit() * scale, bytes.unit() * scale, bytes.unit() * scale);
-    }
-  }
-  return xyz;
-}
-
-[[noreturn]] void broken(const char *promise) {
-  std::fprintf(stderr, "reconstruct broke its promise: %s\n", promise);
-  std::abort();
-}
-
-} // namespace
-
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size) {
-  ByteReader bytes(data, size);
+  pcl_ms_fuzz::ByteReader bytes(data, size);
   pcl_ms::Parameters parameters;
   const std::uint8_t options = bytes.byte();
   parameters.fill_holes_max_edges = (options & 1) ? 0 : 8;
@@ -99,7 +20,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
   parameters.num_threads = (options & 4) ? 2 : 1;
   parameters.error_recovery = (options & 8) == 0;
   parameters.rho = 1.0 + (options >> 4);
-  const std::vector<float> xyz = buildCloud(bytes);
+  const std::vector<float> xyz = pcl_ms_fuzz::buildCloud(bytes);
 
   pcl_ms::PointView view;
   view.xyz = xyz.data();
@@ -110,17 +31,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
   } catch (const pcl_ms::ReconstructionError &) {
     return 0; // a clear error is an allowed outcome
   }
-  std::vector<Eigen::Vector3d> positions;
-  for (std::size_t i = 0; i < view.size; ++i)
-    positions.emplace_back(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
-  for (const pcl_ms::Triangle &triangle : result.triangles)
-    for (pcl_ms::VertexIndex v : triangle)
-      if (v >= view.size || !positions[v].allFinite())
-        broken("triangles use valid records only");
-  const pcl_ms::MeshTopologyReport report = pcl_ms::analyzeMesh(positions, result.triangles);
-  if (report.non_manifold_edges != 0 || report.non_manifold_vertices != 0)
-    broken("the mesh is a 2-manifold");
-  if (report.duplicate_triangles != 0)
-    broken("no triangle appears twice");
+  pcl_ms_fuzz::checkMesh(xyz, {}, result, true);
   return 0;
 }
