@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // What the reconstruct fuzz targets share: small clouds built from the
 // fuzzer's bytes in the shapes that trouble Delaunay-based methods, and the
-// promises every result keeps.
+// promises every reconstruct() result keeps.
 #pragma once
+
+#include "fuzz_bytes.h"
 
 #include <pcl_ms/mesh_quality.h>
 #include <pcl_ms/reconstruct.h>
@@ -18,27 +20,6 @@
 namespace pcl_ms_fuzz {
 
 inline constexpr std::size_t max_points = 96;
-
-/// Reads the fuzzer's bytes front to back; zeros once they run out.
-class ByteReader {
-public:
-  ByteReader(const std::uint8_t *data, std::size_t size) : data_(data), size_(size) {}
-  std::uint8_t byte() { return position_ < size_ ? data_[position_++] : 0; }
-  float rawFloat() {
-    std::uint8_t bytes[4] = {byte(), byte(), byte(), byte()};
-    float value;
-    std::memcpy(&value, bytes, sizeof value);
-    return value;
-  }
-  /// In [-1, 1] in steps of 1/127.
-  float unit() { return (static_cast<int>(byte()) - 128) / 127.0f; }
-  bool empty() const { return position_ >= size_; }
-
-private:
-  const std::uint8_t *data_;
-  std::size_t size_;
-  std::size_t position_ = 0;
-};
 
 inline void addPoint(std::vector<float> &xyz, float x, float y, float z) {
   if (xyz.size() < 3 * max_points)
@@ -81,11 +62,6 @@ inline std::vector<float> buildCloud(ByteReader &bytes) {
     }
   }
   return xyz;
-}
-
-[[noreturn]] inline void broken(const char *promise) {
-  std::fprintf(stderr, "reconstruct broke its promise: %s\n", promise);
-  std::abort();
 }
 
 /// The promises every reconstruct() result keeps: triangles over valid

@@ -4,6 +4,8 @@
 // (PCL_MS_FUZZ_EXTENSION) and read with loadPointCloud (PCL_MS_FUZZ_MESH 0)
 // or loadMesh (1). The readers must return true or false with a reason,
 // never crash, hang or hand back data that contradicts what they promise.
+#include "fuzz_bytes.h"
+
 #include <pcl_ms/io.h>
 
 #include <unistd.h>
@@ -22,10 +24,7 @@ const std::string &scratchPath() {
   return path;
 }
 
-[[noreturn]] void broken(const char *promise) {
-  std::fprintf(stderr, "reader broke its promise: %s\n", promise);
-  std::abort();
-}
+using pcl_ms_fuzz::broken;
 
 #if !PCL_MS_FUZZ_MESH
 void checkCloud(const pcl::PCLPointCloud2 &cloud) {

@@ -3,13 +3,20 @@
 // checks, point-type choice, meshing, marker arrays. No ROS master needed.
 #include "cloud_meshing.h"
 
+// The fuzz target's body and its promises, for the corpus replay below.
+#include "../fuzz/cloud_message_fuzzer.cpp"
+
 #include <gtest/gtest.h>
 
 #include <pcl/io/pcd_io.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <utility>
@@ -336,4 +343,25 @@ TEST(RosBridgeMarkers, BoundaryLinesCloseEachLoop) {
   // The closing edge runs from the last point back to the first.
   EXPECT_EQ(geometry.points[4], (std::array<float, 3>{0, 1, 0}));
   EXPECT_EQ(geometry.points[5], (std::array<float, 3>{0, 0, 0}));
+}
+
+// Every message of the fuzz corpus (seeds and fixed findings) is refused or
+// meshed, with the fuzz target's promises kept (a broken one aborts).
+TEST(RosBridgeFuzzCorpus, EveryMessageIsRefusedOrMeshed) {
+  namespace fs = std::filesystem;
+  const fs::path corpus =
+      fs::path(PCL_MS_DATA_DIR) / ".." / "tests" / "fuzz" / "corpus" / "cloud_message";
+  std::vector<fs::path> files;
+  for (const auto &entry : fs::directory_iterator(corpus))
+    files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  ASSERT_FALSE(files.empty());
+  for (const fs::path &file : files) {
+    SCOPED_TRACE(file.filename().string());
+    std::ifstream in(file, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(
+        LLVMFuzzerTestOneInput(reinterpret_cast<const std::uint8_t *>(bytes.data()), bytes.size()),
+        0);
+  }
 }
