@@ -34,26 +34,23 @@ std::vector<fs::path> corpusFiles(const std::string &target) {
   return files;
 }
 
-TEST(FuzzCorpus, ReconstructRunsEveryInputToAMeshOrAnError) {
-  const std::vector<fs::path> files = corpusFiles("reconstruct");
+/// Runs a reconstruct target's body on every file of its corpus.
+void replayCorpus(const std::string &target, int (*run)(const std::uint8_t *, std::size_t)) {
+  const std::vector<fs::path> files = corpusFiles(target);
   ASSERT_FALSE(files.empty());
   for (const fs::path &file : files) {
     SCOPED_TRACE(file.filename().string());
     const std::string bytes = readFile(file.string());
-    EXPECT_NO_THROW(
-        LLVMFuzzerTestOneInput(reinterpret_cast<const std::uint8_t *>(bytes.data()), bytes.size()));
+    EXPECT_NO_THROW(run(reinterpret_cast<const std::uint8_t *>(bytes.data()), bytes.size()));
   }
 }
 
+TEST(FuzzCorpus, ReconstructRunsEveryInputToAMeshOrAnError) {
+  replayCorpus("reconstruct", &LLVMFuzzerTestOneInput);
+}
+
 TEST(FuzzCorpus, ReconstructWithEveryOptionalInputRunsToAMeshOrAnError) {
-  const std::vector<fs::path> files = corpusFiles("reconstruct_inputs");
-  ASSERT_FALSE(files.empty());
-  for (const fs::path &file : files) {
-    SCOPED_TRACE(file.filename().string());
-    const std::string bytes = readFile(file.string());
-    EXPECT_NO_THROW(pcl_ms_fuzz::reconstructInputsOneInput(
-        reinterpret_cast<const std::uint8_t *>(bytes.data()), bytes.size()));
-  }
+  replayCorpus("reconstruct_inputs", &pcl_ms_fuzz::reconstructInputsOneInput);
 }
 
 class FuzzCorpusReaders : public TempDirTest {};
