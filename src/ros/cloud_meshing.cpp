@@ -4,10 +4,10 @@
 #include <pcl_ms/medial_scaffold_reconstruction.h>
 
 #include <pcl/PCLPointField.h>
-#include <pcl/conversions.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -126,12 +126,48 @@ std::array<float, 4> readColor(const pcl::PCLPointCloud2 &cloud, std::uint32_t f
           static_cast<float>(packed & 0xff) / 255.0f, 1.0f};
 }
 
+// The typed cloud of a cloud whose layout checkCloudLayout accepted (and, for
+// PointNormal, with FLOAT32 normals): only what meshing reads. Unlike
+// pcl::fromPCLPointCloud2 it does not warn, on every message, about the
+// fields the point type has and the message lacks (a PointNormal's
+// curvature).
+template <typename PointT>
+void copyPoints(const pcl::PCLPointCloud2 &cloud, pcl::PointCloud<PointT> &points) {
+  points.header = cloud.header;
+  points.width = cloud.width;
+  points.height = cloud.height;
+  points.is_dense = cloud.is_dense;
+  points.resize(static_cast<std::size_t>(cloud.width) * cloud.height);
+  const std::array<const char *, 3> axes = {"x", "y", "z"};
+  std::array<std::uint32_t, 3> xyz{};
+  for (int k = 0; k < 3; ++k)
+    xyz[k] = findField(cloud.fields, axes[k])->offset;
+  std::array<std::uint32_t, 3> normal{};
+  if constexpr (pcl::traits::has_normal_v<PointT>) {
+    const std::array<const char *, 3> components = {"normal_x", "normal_y", "normal_z"};
+    for (int k = 0; k < 3; ++k)
+      normal[k] = findField(cloud.fields, components[k])->offset;
+  }
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const std::size_t base = pointOffset(cloud, i);
+    PointT &point = points[i];
+    point.x = readFloat(cloud, base + xyz[0]);
+    point.y = readFloat(cloud, base + xyz[1]);
+    point.z = readFloat(cloud, base + xyz[2]);
+    if constexpr (pcl::traits::has_normal_v<PointT>) {
+      point.normal_x = readFloat(cloud, base + normal[0]);
+      point.normal_y = readFloat(cloud, base + normal[1]);
+      point.normal_z = readFloat(cloud, base + normal[2]);
+    }
+  }
+}
+
 template <typename PointT>
 void meshTypedCloud(const pcl::PCLPointCloud2 &cloud, const pcl_ms::Parameters &parameters,
                     bool use_normals, MeshingOutcome &outcome) {
   const Clock::time_point conversion_start = Clock::now();
   typename pcl::PointCloud<PointT>::Ptr points(new pcl::PointCloud<PointT>);
-  pcl::fromPCLPointCloud2(cloud, *points);
+  copyPoints(cloud, *points);
   outcome.conversion_seconds = secondsSince(conversion_start);
 
   pcl::MedialScaffoldReconstruction<PointT> reconstruction;
