@@ -6,11 +6,12 @@
 
 #include <pcl_ms/io.h>
 
-// The reconstruct targets' bodies and their promises, checked as they are
-// while fuzzing (a broken promise aborts). fuzz_reconstruct_inputs's body is
-// called by name: both targets' entry points have libFuzzer's one name.
+// The reconstruct and metrics targets' bodies and their promises, checked as
+// they are while fuzzing (a broken promise aborts). All but fuzz_reconstruct's
+// are called by name: every target's entry point has libFuzzer's one name.
 #include "fuzz/reconstruct_fuzzer.cpp"
 #define PCL_MS_FUZZ_REPLAY
+#include "fuzz/mesh_quality_fuzzer.cpp"
 #include "fuzz/reconstruct_inputs_fuzzer.cpp"
 
 #include <gtest/gtest.h>
@@ -34,7 +35,7 @@ std::vector<fs::path> corpusFiles(const std::string &target) {
   return files;
 }
 
-/// Runs a reconstruct target's body on every file of its corpus.
+/// Runs a target's body on every file of its corpus.
 void replayCorpus(const std::string &target, int (*run)(const std::uint8_t *, std::size_t)) {
   const std::vector<fs::path> files = corpusFiles(target);
   ASSERT_FALSE(files.empty());
@@ -51,6 +52,10 @@ TEST(FuzzCorpus, ReconstructRunsEveryInputToAMeshOrAnError) {
 
 TEST(FuzzCorpus, ReconstructWithEveryOptionalInputRunsToAMeshOrAnError) {
   replayCorpus("reconstruct_inputs", &pcl_ms_fuzz::reconstructInputsOneInput);
+}
+
+TEST(FuzzCorpus, MeshMetricsAreConsistentOnEveryPairOfMeshes) {
+  replayCorpus("mesh_quality", &pcl_ms_fuzz::meshQualityOneInput);
 }
 
 class FuzzCorpusReaders : public TempDirTest {};
