@@ -154,7 +154,9 @@ public:
 
   /** \brief InitialTrianglesMode::fixed (default): the initial triangles stay
    * whatever happens; they must be edge-manifold triangles of valid points,
-   * or reconstruct() fails with the reason. InitialTrianglesMode::preferred:
+   * or reconstruct() fails with the reason (where they meet at a vertex only
+   * and the surface does not join them, that vertex stays a pinch).
+   * InitialTrianglesMode::preferred:
    * they are accepted first but undone like any other candidate where they
    * conflict, so that a soup with wrong, overlapping or repeated triangles
    * gives a manifold mesh; repeated ones are merged, and invalid polygons

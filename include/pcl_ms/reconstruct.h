@@ -27,8 +27,9 @@ Result reconstruct(const PointView &points, const Parameters &parameters);
 /// indices, edge-manifold, each once) are in the surface from the start and
 /// the method completes it around them. Throws ReconstructionError when an
 /// initial triangle uses an invalid or missing point, repeats, is
-/// degenerate, or a third triangle is put on an edge. The one-piece path is
-/// used whatever the cloud's size.
+/// degenerate, or a third triangle is put on an edge. Where they meet at a
+/// vertex only and the surface does not join them, that vertex stays a
+/// pinch. The one-piece path is used whatever the cloud's size.
 Result reconstruct(const PointView &points, const Parameters &parameters,
                    const std::vector<Triangle> &initial_triangles);
 

@@ -65,10 +65,11 @@ inline std::vector<float> buildCloud(ByteReader &bytes) {
 }
 
 /// The promises every reconstruct() result keeps: triangles over valid
-/// records of the cloud (among `allowed` when not empty), each once, and a
-/// 2-manifold unless non-manifold seams were allowed.
-inline void checkMesh(const std::vector<float> &xyz, const std::vector<bool> &allowed,
-                      const pcl_ms::Result &result, bool manifold) {
+/// records of the cloud (among `allowed` when not empty), each once, and,
+/// when `manifold`, a 2-manifold. Returns the mesh's topology.
+inline pcl_ms::MeshTopologyReport checkMesh(const std::vector<float> &xyz,
+                                            const std::vector<bool> &allowed,
+                                            const pcl_ms::Result &result, bool manifold) {
   const std::size_t records = xyz.size() / 3;
   std::vector<Eigen::Vector3d> positions;
   for (std::size_t i = 0; i < records; ++i)
@@ -82,6 +83,7 @@ inline void checkMesh(const std::vector<float> &xyz, const std::vector<bool> &al
     broken("the mesh is a 2-manifold");
   if (report.duplicate_triangles != 0)
     broken("no triangle appears twice");
+  return report;
 }
 
 } // namespace pcl_ms_fuzz

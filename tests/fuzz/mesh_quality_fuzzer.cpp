@@ -54,8 +54,10 @@ void checkTopology(const pcl_ms::MeshTopologyReport &report, std::size_t vertice
       report.orientable != (report.non_orientable_components == 0))
     broken("orientability agrees with its count");
   const auto isShare = [](double value) { return value >= 0 && value <= 1; };
+  // A triangle's smallest angle is at most 60 degrees, up to rounding.
+  constexpr double largest_smallest_angle = 60 + 1e-9;
   if (!isShare(report.used_vertex_fraction) || !isShare(report.share_min_angle_below_10deg) ||
-      !(report.median_min_angle_deg >= 0 && report.median_min_angle_deg <= 60))
+      !(report.median_min_angle_deg >= 0 && report.median_min_angle_deg <= largest_smallest_angle))
     broken("shares and angles in range");
 }
 

@@ -5,8 +5,9 @@
 // degenerate, three on an edge), a viewpoint (any float), non-manifold seams
 // and the medial axis, on the clouds of fuzz_reconstruct. A run must end with
 // a mesh over the selected valid records that keeps every fixed initial
-// triangle (a 2-manifold unless seams are allowed) and a consistent medial
-// axis, or with a ReconstructionError.
+// triangle, a 2-manifold unless seams are allowed (or fixed triangles meet
+// at a vertex only), and a consistent medial axis, or with a
+// ReconstructionError.
 #include "fuzz_clouds.h"
 
 #include <pcl_ms/reconstruct.h>
@@ -16,6 +17,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <vector>
 
 namespace pcl_ms_fuzz {
@@ -111,19 +113,41 @@ inline int reconstructInputsOneInput(const std::uint8_t *data, std::size_t size)
     for (std::int64_t index : indices)
       selected[static_cast<std::size_t>(index)] = true; // all valid, or it threw
   }
-  checkMesh(xyz, selected, result, !parameters.allow_non_manifold);
-  if (initial_mode == 1) {
-    auto sorted = [](pcl_ms::Triangle triangle) {
-      std::sort(triangle.begin(), triangle.end());
-      return triangle;
+  // Fixed triangles are never undone: where they meet at a vertex only (in
+  // the user's records, or once repeated points are merged) and the surface
+  // does not join their fans, that vertex stays a pinch.
+  const bool fixed = initial_mode == 1;
+  const pcl_ms::MeshTopologyReport topology =
+      checkMesh(xyz, selected, result, !parameters.allow_non_manifold && !fixed);
+  if (fixed) {
+    // By corner positions: a repeated point's triangles use its first record.
+    using Corners = std::array<std::array<float, 3>, 3>;
+    auto corners = [&](const pcl_ms::Triangle &triangle) {
+      Corners sorted;
+      for (int k = 0; k < 3; ++k)
+        sorted[k] = {xyz[3 * triangle[k]], xyz[3 * triangle[k] + 1], xyz[3 * triangle[k] + 2]};
+      std::sort(sorted.begin(), sorted.end());
+      return sorted;
     };
-    std::vector<pcl_ms::Triangle> kept;
+    std::vector<Corners> kept;
     for (const pcl_ms::Triangle &triangle : result.triangles)
-      kept.push_back(sorted(triangle));
+      kept.push_back(corners(triangle));
     std::sort(kept.begin(), kept.end());
-    for (const pcl_ms::Triangle &triangle : initial)
-      if (!std::binary_search(kept.begin(), kept.end(), sorted(triangle)))
+    std::map<std::array<float, 3>, int> fixed_corner_uses;
+    for (const pcl_ms::Triangle &triangle : initial) {
+      const Corners position = corners(triangle);
+      if (!std::binary_search(kept.begin(), kept.end(), position))
         broken("fixed initial triangles stay in the surface");
+      for (const auto &corner : position)
+        ++fixed_corner_uses[corner];
+    }
+    if (!parameters.allow_non_manifold) {
+      const auto shared_corners = std::count_if(fixed_corner_uses.begin(), fixed_corner_uses.end(),
+                                                [](const auto &use) { return use.second > 1; });
+      if (topology.non_manifold_edges != 0 ||
+          topology.non_manifold_vertices > static_cast<std::size_t>(shared_corners))
+        broken("the mesh is a 2-manifold but where fixed triangles meet at a vertex only");
+    }
   }
   if (parameters.compute_medial_axis && result.medial_axis)
     checkMedialAxis(*result.medial_axis);
