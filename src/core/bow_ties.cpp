@@ -88,8 +88,15 @@ void dropTriangles(std::vector<Triangle> &triangles, const std::vector<bool> &dr
 } // namespace detail
 
 std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_count,
-                         std::vector<bool> &touched) {
+                         std::vector<bool> &touched, const std::vector<Triangle> *fixed) {
   const std::size_t before = triangles.size();
+  const auto isFixed = [&](std::uint32_t t) {
+    if (!fixed)
+      return false;
+    Triangle corners = triangles[t];
+    std::sort(corners.begin(), corners.end());
+    return std::binary_search(fixed->begin(), fixed->end(), corners);
+  };
   touched.resize(vertex_count, false);
   // After the first round only the corners of what it removed can have
   // gained a second fan: the other vertices kept their triangles.
@@ -107,13 +114,16 @@ std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_co
         continue;
       const std::size_t keep = detail::fanToKeep(fans.size(), [&](std::size_t f) {
         detail::FanWeight weight;
+        weight.fixed =
+            static_cast<std::size_t>(std::count_if(fans[f].begin(), fans[f].end(), isFixed));
         weight.size = fans[f].size();
         return weight;
       });
       for (std::size_t f = 0; f < fans.size(); ++f)
         if (f != keep)
           for (std::uint32_t t : fans[f])
-            drop[t] = changed = true;
+            if (!isFixed(t))
+              drop[t] = changed = true;
     }
     if (changed) {
       std::fill(check.begin(), check.end(), false);

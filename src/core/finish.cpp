@@ -302,9 +302,23 @@ std::vector<std::vector<VertexIndex>> traceBoundaryLoops(const std::vector<Trian
 
 FinishedSurface finishSurface(std::vector<Triangle> triangles,
                               const std::vector<Eigen::Vector3d> &points, int fill_holes_max_edges,
-                              const SideLimit &limit, const std::vector<bool> *anchored_vertices,
+                              const SideLimit &limit, const std::vector<Triangle> *fixed_triangles,
                               const Eigen::Vector3d *viewpoint) {
   FinishedSurface surface;
+  // The user's fixed triangles survive the twist repair: no triangle at their
+  // corners is cut, and the bow-tie split keeps them.
+  std::vector<Triangle> fixed;
+  std::vector<bool> anchored;
+  if (fixed_triangles) {
+    anchored.assign(points.size(), false);
+    for (Triangle triangle : *fixed_triangles) {
+      std::sort(triangle.begin(), triangle.end());
+      fixed.push_back(triangle);
+      for (VertexIndex v : triangle)
+        anchored[v] = true;
+    }
+    std::sort(fixed.begin(), fixed.end());
+  }
   // Room for the fillings, so that they join the list while its neighbours
   // are held: moving a 20M-triangle list then would add 240 MB to the peak.
   triangles.reserve(triangles.size() + triangles.size() / fill_room_divisor + min_fill_room);
@@ -341,13 +355,12 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
     // scans and the camel head apart (car6: 80 pieces instead of 52).
     std::vector<bool> drop(triangles.size(), false);
     for (std::uint32_t t : to_cut)
-      drop[t] = !anchored_vertices ||
-                std::none_of(triangles[t].begin(), triangles[t].end(),
-                             [&](VertexIndex v) { return (*anchored_vertices)[v]; });
+      drop[t] = anchored.empty() || std::none_of(triangles[t].begin(), triangles[t].end(),
+                                                 [&](VertexIndex v) { return anchored[v]; });
     const std::size_t before = triangles.size();
     std::vector<bool> touched(points.size(), false);
     detail::dropTriangles(triangles, drop, touched);
-    splitBowTies(triangles, points.size(), touched);
+    splitBowTies(triangles, points.size(), touched, fixed_triangles ? &fixed : nullptr);
     surface.twist_triangles_removed += before - triangles.size();
     // The loops that removal opened are ours to close, whatever the user's limit.
     to_cut = fillThenOrient(max_untwist_loop_edges, &touched);

@@ -469,13 +469,6 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
   // are not protected: anchoring their corners kept 3 more of them on the
   // bunny soup of tests/test_soup.cpp and left 5 more loops open; sparing
   // just them kept 14 more on CGAL's cow soup but left the cow one-sided.
-  std::vector<bool> anchored;
-  if (!fixed.empty()) {
-    anchored.assign(prepared.positions.size(), false);
-    for (const Triangle &triangle : fixed)
-      for (VertexIndex v : triangle)
-        anchored[v] = true;
-  }
   // The finish stage's parallel loops use the threads the user allowed.
   std::optional<Eigen::Vector3d> viewpoint;
   if (parameters.viewpoint)
@@ -486,8 +479,8 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
   detail::threadArena(parameters.num_threads).execute([&] {
     surface =
         finishSurface(std::move(triangles), prepared.positions, parameters.fill_holes_max_edges,
-                      SideLimit{&local_scale, parameters.rho},
-                      anchored.empty() ? nullptr : &anchored, viewpoint ? &*viewpoint : nullptr);
+                      SideLimit{&local_scale, parameters.rho}, fixed.empty() ? nullptr : &fixed,
+                      viewpoint ? &*viewpoint : nullptr);
   });
   std::vector<std::array<VertexIndex, 2>> seam_edges;
   if (!seam_triangles.empty()) {

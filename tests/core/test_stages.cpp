@@ -458,6 +458,30 @@ TEST(BowTies, SplitKeepsTheLargerFanAndRechecksTheCornersOfWhatItRemoves) {
   EXPECT_EQ(pair, (std::vector<Triangle>{{0, 1, 2}}));
 }
 
+TEST(BowTies, SplitNeverRemovesFixedTriangles) {
+  // As above, with the small fan at vertex 0 holding a fixed triangle: it
+  // stays and the larger fan goes.
+  const std::vector<Triangle> bow_tie = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4},  {0, 5, 6},
+                                         {0, 6, 7}, {7, 8, 9}, {7, 9, 10}, {6, 7, 11}};
+  std::vector<Triangle> triangles = bow_tie;
+  std::vector<bool> touched(12, false);
+  touched[0] = true;
+  const std::vector<Triangle> one_fixed = {{0, 5, 6}};
+  EXPECT_EQ(splitBowTies(triangles, 12, touched, &one_fixed), 3u);
+  EXPECT_EQ(triangles,
+            (std::vector<Triangle>{{0, 5, 6}, {0, 6, 7}, {7, 8, 9}, {7, 9, 10}, {6, 7, 11}}));
+
+  // Both fans hold one: the larger stays whole, the other loses only what
+  // is not fixed, and vertex 0 stays a pinch.
+  triangles = bow_tie;
+  std::fill(touched.begin(), touched.end(), false);
+  touched[0] = true;
+  const std::vector<Triangle> two_fixed = {{0, 1, 2}, {0, 5, 6}};
+  EXPECT_EQ(splitBowTies(triangles, 12, touched, &two_fixed), 2u);
+  EXPECT_EQ(triangles, (std::vector<Triangle>{
+                           {0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 5, 6}, {7, 8, 9}, {7, 9, 10}}));
+}
+
 // ---- finish --------------------------------------------------------------------------
 
 TEST(Finish, BoundaryLoopOfTwoTriangles) {

@@ -42,17 +42,22 @@ std::vector<std::uint32_t> orientComponents(std::vector<Triangle> &triangles,
                                             std::vector<bool> &component_orientable,
                                             const Eigen::Vector3d *viewpoint = nullptr);
 
-/// Keeps one fan (the largest) at every touched vertex whose triangles form
-/// several, until none has more than one; the corners of removed triangles
-/// become touched. Returns how many triangles it removed.
+/// Keeps one fan at every touched vertex whose triangles form several (the
+/// one with more `fixed` triangles, then the largest: fan_choice.h), until
+/// none has more than one; the corners of removed triangles become touched.
+/// `fixed` (null, or triangles with ascending corners, sorted) are never
+/// removed: where two fans hold some, the vertex stays a pinch. Returns how
+/// many triangles it removed.
 std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_count,
-                         std::vector<bool> &touched);
+                         std::vector<bool> &touched, const std::vector<Triangle> *fixed = nullptr);
 
-/// All of the above in order.
+/// All of the above in order. `fixed_triangles` (null, or the user's fixed
+/// initial triangles, any corner order) survive it: the twist repair keeps
+/// every triangle at their corners, the bow-tie split keeps them.
 FinishedSurface finishSurface(std::vector<Triangle> triangles,
                               const std::vector<Eigen::Vector3d> &points, int fill_holes_max_edges,
                               const SideLimit &limit,
-                              const std::vector<bool> *anchored_vertices = nullptr,
+                              const std::vector<Triangle> *fixed_triangles = nullptr,
                               const Eigen::Vector3d *viewpoint = nullptr);
 
 /// The seam pass's triangles (docs/algorithm.md, "Seams (opt-in)") join a
