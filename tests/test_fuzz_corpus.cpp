@@ -7,11 +7,11 @@
 #include <pcl_ms/io.h>
 
 // The reconstruct and metrics targets' bodies and their promises, checked as
-// they are while fuzzing (a broken promise aborts). All but fuzz_reconstruct's
-// are called by name: every target's entry point has libFuzzer's one name.
-#include "fuzz/reconstruct_fuzzer.cpp"
+// they are while fuzzing (a broken promise aborts), without the entry point
+// libFuzzer calls.
 #define PCL_MS_FUZZ_REPLAY
 #include "fuzz/mesh_quality_fuzzer.cpp"
+#include "fuzz/reconstruct_fuzzer.cpp"
 #include "fuzz/reconstruct_inputs_fuzzer.cpp"
 
 #include <gtest/gtest.h>
@@ -47,7 +47,7 @@ void replayCorpus(const std::string &target, int (*run)(const std::uint8_t *, st
 }
 
 TEST(FuzzCorpus, ReconstructRunsEveryInputToAMeshOrAnError) {
-  replayCorpus("reconstruct", &LLVMFuzzerTestOneInput);
+  replayCorpus("reconstruct", &pcl_ms_fuzz::reconstructOneInput);
 }
 
 TEST(FuzzCorpus, ReconstructWithEveryOptionalInputRunsToAMeshOrAnError) {

@@ -23,8 +23,11 @@ constexpr std::uint64_t max_points = 128;
 
 } // namespace
 
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size) {
-  pcl_ms_fuzz::ByteReader bytes(data, size);
+namespace pcl_ms_fuzz {
+
+/// The target's body (see PCL_MS_FUZZ_TARGET).
+inline int cloudMessageOneInput(const std::uint8_t *data, std::size_t size) {
+  ByteReader bytes(data, size);
   static const char *const names[] = {"x",        "y",   "z",    "normal_x",  "normal_y",
                                       "normal_z", "rgb", "rgba", "intensity", ""};
   constexpr int name_count = sizeof names / sizeof names[0];
@@ -61,9 +64,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
       for (const pcl::Vertices &polygon : *list)
         for (std::uint32_t v : polygon.vertices)
           if (v >= points)
-            pcl_ms_fuzz::broken("polygons and loops index the cloud");
+            broken("polygons and loops index the cloud");
   } else if (!outcome.polygons.empty()) {
-    pcl_ms_fuzz::broken("a refused cloud has no mesh");
+    broken("a refused cloud has no mesh");
   }
   // The marker builders take polygons from anywhere: the mesh's, and some
   // made of the message's own bytes (any index, any size).
@@ -76,15 +79,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
         pcl_ms::ros_bridge::triangleListGeometry(cloud, *list);
     if (triangles.points.size() % 3 != 0 ||
         (!triangles.colors.empty() && triangles.colors.size() != triangles.points.size()))
-      pcl_ms_fuzz::broken("a triangle list has three points a triangle and a colour a point");
+      broken("a triangle list has three points a triangle and a colour a point");
     for (const auto &point : triangles.points)
       if (!std::isfinite(point[0]) || !std::isfinite(point[1]) || !std::isfinite(point[2]))
-        pcl_ms_fuzz::broken("marker points are finite");
+        broken("marker points are finite");
   }
   const pcl_ms::ros_bridge::MarkerGeometry lines =
       pcl_ms::ros_bridge::boundaryLineGeometry(cloud, outcome.boundary_loops);
   if (lines.points.size() % 2 != 0)
-    pcl_ms_fuzz::broken("a line list has two points a line");
+    broken("a line list has two points a line");
   pcl_ms::ros_bridge::boundaryLineGeometry(cloud, arbitrary);
   return 0;
 }
+
+} // namespace pcl_ms_fuzz
+
+PCL_MS_FUZZ_TARGET(pcl_ms_fuzz::cloudMessageOneInput)

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The fuzz targets' reader of the fuzzer's bytes, and how a target reports a
-// broken promise (it aborts, which libFuzzer records as a finding).
+// The fuzz targets' reader of the fuzzer's bytes, how a target reports a
+// broken promise (it aborts, which libFuzzer records as a finding), and its
+// entry point.
 #pragma once
 
 #include <algorithm>
@@ -47,3 +48,15 @@ private:
 }
 
 } // namespace pcl_ms_fuzz
+
+// Each target's body is a named function, so that the tests can replay
+// every corpus in one program: there (PCL_MS_FUZZ_REPLAY) the entry point
+// that libFuzzer calls, one name for all targets, is left out.
+#ifdef PCL_MS_FUZZ_REPLAY
+#define PCL_MS_FUZZ_TARGET(body)
+#else
+#define PCL_MS_FUZZ_TARGET(body)                                                                   \
+  extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size) {              \
+    return body(data, size);                                                                       \
+  }
+#endif

@@ -75,8 +75,7 @@ void checkDistances(const pcl_ms::DistanceStats &stats) {
 
 namespace pcl_ms_fuzz {
 
-/// The target's body; a named function, so that the corpus replay can run
-/// it beside fuzz_reconstruct's.
+/// The target's body (see PCL_MS_FUZZ_TARGET).
 inline int meshQualityOneInput(const std::uint8_t *data, std::size_t size) {
   ByteReader bytes(data, size);
   pcl_ms::ReferenceOptions options;
@@ -122,8 +121,4 @@ inline int meshQualityOneInput(const std::uint8_t *data, std::size_t size) {
 
 } // namespace pcl_ms_fuzz
 
-#ifndef PCL_MS_FUZZ_REPLAY
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size) {
-  return pcl_ms_fuzz::meshQualityOneInput(data, size);
-}
-#endif
+PCL_MS_FUZZ_TARGET(pcl_ms_fuzz::meshQualityOneInput)

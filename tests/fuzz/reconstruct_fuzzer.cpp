@@ -11,8 +11,11 @@
 #include <cstdint>
 #include <vector>
 
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size) {
-  pcl_ms_fuzz::ByteReader bytes(data, size);
+namespace pcl_ms_fuzz {
+
+/// The target's body (see PCL_MS_FUZZ_TARGET).
+inline int reconstructOneInput(const std::uint8_t *data, std::size_t size) {
+  ByteReader bytes(data, size);
   pcl_ms::Parameters parameters;
   const std::uint8_t options = bytes.byte();
   parameters.fill_holes_max_edges = (options & 1) ? 0 : 8;
@@ -20,7 +23,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
   parameters.num_threads = (options & 4) ? 2 : 1;
   parameters.error_recovery = (options & 8) == 0;
   parameters.rho = 1.0 + (options >> 4);
-  const std::vector<float> xyz = pcl_ms_fuzz::buildCloud(bytes);
+  const std::vector<float> xyz = buildCloud(bytes);
 
   pcl_ms::PointView view;
   view.xyz = xyz.data();
@@ -31,6 +34,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
   } catch (const pcl_ms::ReconstructionError &) {
     return 0; // a clear error is an allowed outcome
   }
-  pcl_ms_fuzz::checkMesh(xyz, {}, result, true);
+  checkMesh(xyz, {}, result, true);
   return 0;
 }
+
+} // namespace pcl_ms_fuzz
+
+PCL_MS_FUZZ_TARGET(pcl_ms_fuzz::reconstructOneInput)

@@ -46,8 +46,7 @@ inline void checkMedialAxis(const pcl_ms::MedialAxis &axis) {
     broken("medial-axis curves are sorted");
 }
 
-/// The target's body; a named function, so that the corpus replay can run
-/// it beside fuzz_reconstruct's.
+/// The target's body (see PCL_MS_FUZZ_TARGET).
 inline int reconstructInputsOneInput(const std::uint8_t *data, std::size_t size) {
   ByteReader bytes(data, size);
   const std::uint8_t options = bytes.byte(), more = bytes.byte();
@@ -156,8 +155,4 @@ inline int reconstructInputsOneInput(const std::uint8_t *data, std::size_t size)
 
 } // namespace pcl_ms_fuzz
 
-#ifndef PCL_MS_FUZZ_REPLAY
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size) {
-  return pcl_ms_fuzz::reconstructInputsOneInput(data, size);
-}
-#endif
+PCL_MS_FUZZ_TARGET(pcl_ms_fuzz::reconstructInputsOneInput)

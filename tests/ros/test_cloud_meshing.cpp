@@ -4,6 +4,7 @@
 #include "cloud_meshing.h"
 
 // The fuzz target's body and its promises, for the corpus replay below.
+#define PCL_MS_FUZZ_REPLAY
 #include "../fuzz/cloud_message_fuzzer.cpp"
 
 #include <gtest/gtest.h>
@@ -364,8 +365,8 @@ TEST(RosBridgeFuzzCorpus, EveryMessageIsRefusedOrMeshed) {
     SCOPED_TRACE(file.filename().string());
     std::ifstream in(file, std::ios::binary);
     const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    EXPECT_EQ(
-        LLVMFuzzerTestOneInput(reinterpret_cast<const std::uint8_t *>(bytes.data()), bytes.size()),
-        0);
+    EXPECT_EQ(pcl_ms_fuzz::cloudMessageOneInput(
+                  reinterpret_cast<const std::uint8_t *>(bytes.data()), bytes.size()),
+              0);
   }
 }
