@@ -465,16 +465,16 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
 
   deadline.check("the greedy passes");
   stage = Clock::now();
-  // The user's fixed triangles must survive the twist repair. Preferred ones
-  // are not protected: anchoring their corners kept 3 more of them on the
-  // bunny soup of tests/test_soup.cpp and left 5 more loops open; sparing
-  // just them kept 14 more on CGAL's cow soup but left the cow one-sided.
-  // The finish stage's parallel loops use the threads the user allowed.
   std::optional<Eigen::Vector3d> viewpoint;
   if (parameters.viewpoint)
     viewpoint = Eigen::Vector3d((*parameters.viewpoint)[0], (*parameters.viewpoint)[1],
                                 (*parameters.viewpoint)[2]) -
                 prepared.centre;
+  // The user's fixed triangles must survive the twist repair. Preferred ones
+  // are not protected: anchoring their corners kept 3 more of them on the
+  // bunny soup of tests/test_soup.cpp and left 5 more loops open; sparing
+  // just them kept 14 more on CGAL's cow soup but left the cow one-sided.
+  // The finish stage's parallel loops use the threads the user allowed.
   FinishedSurface surface;
   detail::threadArena(parameters.num_threads).execute([&] {
     surface =
