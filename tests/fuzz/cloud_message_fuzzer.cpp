@@ -19,7 +19,7 @@
 namespace {
 
 /// At most this many points a message: meshing is the slow part.
-constexpr std::uint64_t max_points = 128;
+constexpr std::uint64_t max_message_points = 128;
 
 } // namespace
 
@@ -40,7 +40,7 @@ inline int cloudMessageOneInput(const std::uint8_t *data, std::size_t size) {
   parameters.fill_holes_max_edges = (options & 8) ? 0 : 8;
   cloud.width = bytes.byte() % 16;
   cloud.height = bytes.byte() % 16;
-  if (std::uint64_t{cloud.width} * cloud.height > max_points)
+  if (std::uint64_t{cloud.width} * cloud.height > max_message_points)
     return 0;
   cloud.point_step = bytes.byte();
   cloud.row_step = bytes.word();
