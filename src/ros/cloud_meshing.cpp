@@ -69,13 +69,18 @@ float readFloat(const pcl::PCLPointCloud2 &cloud, std::size_t offset) {
   return value;
 }
 
+// Byte offsets within a point of three fields the cloud is known to have.
+std::array<std::uint32_t, 3> fieldOffsets(const pcl::PCLPointCloud2 &cloud,
+                                          const std::array<const char *, 3> &names) {
+  return {findField(cloud.fields, names[0])->offset, findField(cloud.fields, names[1])->offset,
+          findField(cloud.fields, names[2])->offset};
+}
+
 // Reads positions from a cloud whose layout checkCloudLayout accepted.
 class PositionReader {
 public:
   explicit PositionReader(const pcl::PCLPointCloud2 &cloud)
-      : cloud_(cloud), offsets_{findField(cloud.fields, "x")->offset,
-                                findField(cloud.fields, "y")->offset,
-                                findField(cloud.fields, "z")->offset},
+      : cloud_(cloud), offsets_(fieldOffsets(cloud, {"x", "y", "z"})),
         point_count_(static_cast<std::size_t>(cloud.width) * cloud.height) {}
 
   // False when `index` lies outside the cloud or the point is not finite.
@@ -138,16 +143,10 @@ void copyPoints(const pcl::PCLPointCloud2 &cloud, pcl::PointCloud<PointT> &point
   points.height = cloud.height;
   points.is_dense = cloud.is_dense;
   points.resize(static_cast<std::size_t>(cloud.width) * cloud.height);
-  const std::array<const char *, 3> axes = {"x", "y", "z"};
-  std::array<std::uint32_t, 3> xyz{};
-  for (int k = 0; k < 3; ++k)
-    xyz[k] = findField(cloud.fields, axes[k])->offset;
+  const std::array<std::uint32_t, 3> xyz = fieldOffsets(cloud, {"x", "y", "z"});
   std::array<std::uint32_t, 3> normal{};
-  if constexpr (pcl::traits::has_normal_v<PointT>) {
-    const std::array<const char *, 3> components = {"normal_x", "normal_y", "normal_z"};
-    for (int k = 0; k < 3; ++k)
-      normal[k] = findField(cloud.fields, components[k])->offset;
-  }
+  if constexpr (pcl::traits::has_normal_v<PointT>)
+    normal = fieldOffsets(cloud, {"normal_x", "normal_y", "normal_z"});
   for (std::size_t i = 0; i < points.size(); ++i) {
     const std::size_t base = pointOffset(cloud, i);
     PointT &point = points[i];

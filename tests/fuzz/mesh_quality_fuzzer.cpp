@@ -28,6 +28,8 @@ std::vector<pcl_ms::Triangle> buildTriangles(pcl_ms_fuzz::ByteReader &bytes,
   return triangles;
 }
 
+bool isShare(double value) { return value >= 0 && value <= 1; }
+
 std::vector<Eigen::Vector3d> toVertices(const std::vector<float> &xyz) {
   std::vector<Eigen::Vector3d> vertices;
   for (std::size_t i = 0; i + 2 < xyz.size(); i += 3)
@@ -53,7 +55,6 @@ void checkTopology(const pcl_ms::MeshTopologyReport &report, std::size_t vertice
   if (report.non_orientable_components > report.components ||
       report.orientable != (report.non_orientable_components == 0))
     broken("orientability agrees with its count");
-  const auto isShare = [](double value) { return value >= 0 && value <= 1; };
   // A triangle's smallest angle is at most 60 degrees, up to rounding.
   constexpr double largest_smallest_angle = 60 + 1e-9;
   if (!isShare(report.used_vertex_fraction) || !isShare(report.share_min_angle_below_10deg) ||
@@ -103,7 +104,6 @@ inline int meshQualityOneInput(const std::uint8_t *data, std::size_t size) {
   checkTopology(pcl_ms::analyzeMesh(vertices, triangles), vertices.size(), triangles.size());
   const pcl_ms::ReferenceReport report = pcl_ms::compareWithReference(
       vertices, triangles, reference_vertices, reference_triangles, options);
-  const auto isShare = [](double value) { return value >= 0 && value <= 1; };
   if (report.triangles != triangles.size() ||
       report.reference_triangles != reference_triangles.size() ||
       report.recovered_reference_triangles > report.reference_triangles ||
