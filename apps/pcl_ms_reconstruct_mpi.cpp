@@ -2,8 +2,8 @@
 // pcl_ms_reconstruct_mpi: pcl_ms_reconstruct across the ranks of an MPI job,
 // with the same options and the same triangles for any number of ranks.
 //
-// The ranks read their own byte ranges of a binary PCD and send them to
-// rank 0 (other formats: rank 0 reads). Rank 0 prepares the points, builds
+// The ranks read their own byte ranges of a binary PCD or PLY and send them
+// to rank 0 (other formats: rank 0 reads). Rank 0 prepares the points, builds
 // the bucket tree and hands each bucket and seam zone as a task to a free
 // rank (pcl_ms_mpi::MpiUnitFarm), meshing one itself meanwhile; the other
 // ranks hold one unit at a time, never the cloud (docs/algorithm.md,
@@ -110,8 +110,8 @@ struct SliceStatus {
   int readers = 1;    // ranks that read a part
 };
 
-/// Every rank reads the records of its own byte range of a binary PCD and
-/// sends them to rank 0, which alone ends with all points (docs/algorithm.md,
+/// Every rank reads the records of its own byte range of a binary PCD or PLY
+/// and sends them to rank 0, which alone ends with all points (docs/algorithm.md,
 /// "Across processes"). A range the file does not hold fails on its rank,
 /// with the reason there, and every rank returns kIoFailure.
 template <typename PointT>
@@ -223,7 +223,7 @@ pcl_ms::Result meshPoints(const Job &job, pcl::PointCloud<PointT> &&points,
 /// How the input reaches the ranks; rank 0 decides, every rank gets it.
 struct Input {
   pcl_ms_mpi::BinaryCloudLayout layout;
-  int in_parts = 0; // each rank reads its own byte range of a binary PCD
+  int in_parts = 0; // each rank reads its own byte range of a binary PCD or PLY
 };
 
 /// The points on every rank, meshed; rank 0 saves the mesh. `cloud` is
@@ -315,7 +315,7 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
     print_info(" triangles]\n");
   }
 
-  // Rank 0 writes. A binary PCD of x y z only, all finite, into a PLY: the
+  // Rank 0 writes. A binary PCD or PLY of x y z only, all finite, into a PLY: the
   // vertices go from the input to the output a block at a time, so rank 0
   // never holds the cloud (the same bytes as PCL's writer). Otherwise it
   // loads the file now, after the meshing has freed the points.
@@ -422,10 +422,10 @@ int run(const Job &job, int argc, char **argv) {
     status = pcl_ms_tools::checkMeshOutput(options.output, error);
     if (status == kSuccess)
       status = pcl_ms_tools::checkMedialAxisOutput(options.medial_axis, error);
-    // A binary PCD is read in parts, unless normals are to be estimated
+    // A binary PCD or PLY is read in parts, unless normals are to be estimated
     // (on the whole cloud) or asked for and absent (the loader says so).
     if (status == kSuccess && options.estimate_normals == 0 &&
-        pcl_ms_mpi::describeBinaryPcd(options.input, input.layout, fields) &&
+        pcl_ms_mpi::describeBinaryCloud(options.input, input.layout, fields) &&
         (!options.normals || input.layout.hasNormals())) {
       input.in_parts = 1;
       if (!parameters.viewpoint && !options.no_viewpoint) {

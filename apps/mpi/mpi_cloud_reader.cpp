@@ -3,6 +3,8 @@
 
 #include "io_parsing.h"
 
+#include <pcl_ms/mesh_file.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -16,6 +18,11 @@ namespace pcl_ms_mpi {
 using pcl_ms::io_detail::PcdData;
 using pcl_ms::io_detail::PcdField;
 using pcl_ms::io_detail::PcdHeader;
+using pcl_ms::io_detail::PlyElement;
+using pcl_ms::io_detail::PlyFormat;
+using pcl_ms::io_detail::PlyHeader;
+using pcl_ms::io_detail::PlyProperty;
+using pcl_ms::io_detail::PlyType;
 
 bool describeBinaryPcd(const std::string &path, BinaryCloudLayout &layout, std::string &fields) {
   // PCD binary data is the writer's memory: little-endian in practice.
@@ -75,6 +82,106 @@ bool describeBinaryPcd(const std::string &path, BinaryCloudLayout &layout, std::
   return true;
 }
 
+bool describeBinaryPly(const std::string &path, BinaryCloudLayout &layout, std::string &fields) {
+  if (!pcl_ms::io_detail::hostIsLittleEndian())
+    return false;
+  std::error_code code;
+  const std::uintmax_t size = std::filesystem::file_size(path, code);
+  if (code)
+    return false;
+  std::ifstream in(path, std::ios::binary);
+  PlyHeader header;
+  std::string ignored;
+  if (!pcl_ms::io_detail::parsePlyHeader(in, header, ignored) ||
+      header.format != PlyFormat::BinaryLittleEndian || header.has_obj_info ||
+      header.find("range_grid") || header.elements.empty() ||
+      header.elements.front().name != "vertex")
+    return false;
+  // The vertices come first, so their records start right after the header.
+  const PlyElement &vertices = header.elements.front();
+  if (vertices.count == 0 || vertices.count >= UINT32_MAX || header.find("vertex") != &vertices)
+    return false;
+  BinaryCloudLayout found;
+  static const char *const axes[3] = {"x", "y", "z"};
+  static const char *const normals[3] = {"normal_x", "normal_y", "normal_z"};
+  // PCL writes normals as nx, ny, nz to PLY and reads them back as normal_x...
+  static const char *const short_normals[3] = {"nx", "ny", "nz"};
+  std::array<int, 3> axis_count = {0, 0, 0}, normal_count = {0, 0, 0};
+  std::uint64_t offset = 0;
+  std::string names;
+  for (const PlyProperty &property : vertices.properties) {
+    if (property.is_list)
+      return false; // records of varying size
+    std::string name = property.name;
+    for (int k = 0; k < 3; ++k) {
+      if (name == short_normals[k])
+        name = normals[k];
+      if (name == axes[k]) {
+        if (property.value_type != PlyType::Float32)
+          return false;
+        found.xyz[k] = static_cast<std::uint32_t>(offset);
+        ++axis_count[k];
+      } else if (name == normals[k]) {
+        if (property.value_type == PlyType::Float32)
+          found.normal[k] = static_cast<std::int32_t>(offset);
+        ++normal_count[k];
+      }
+    }
+    offset += pcl_ms::io_detail::plyTypeSize(property.value_type);
+    names += (names.empty() ? "" : " ") + name;
+  }
+  // A coordinate or normal named twice is left to rank 0's reader.
+  if (axis_count != std::array<int, 3>{1, 1, 1} ||
+      *std::max_element(normal_count.begin(), normal_count.end()) > 1 || offset > UINT32_MAX)
+    return false;
+  // More records than the file could hold: rank 0's guarded loader reports it.
+  if (vertices.count > size / offset)
+    return false;
+  // What follows the vertices must be of fixed size (PCL's camera element,
+  // not faces), so that a file cut short after the vertices is noticed too:
+  // then rank 0's reader reports it. A file cut within the vertices is
+  // reported by the rank whose range is missing, as for a PCD.
+  std::uint64_t after_vertices = 0;
+  for (std::size_t e = 1; e < header.elements.size(); ++e) {
+    std::uint64_t record = 0;
+    for (const PlyProperty &property : header.elements[e].properties) {
+      if (property.is_list)
+        return false;
+      record += pcl_ms::io_detail::plyTypeSize(property.value_type);
+    }
+    if (record > 0 && header.elements[e].count > size / record)
+      return false;
+    after_vertices += record * header.elements[e].count;
+    if (after_vertices > size)
+      return false;
+  }
+  const std::uint64_t vertices_end = header.header_bytes + vertices.count * offset;
+  if (size >= vertices_end && size - vertices_end < after_vertices)
+    return false;
+  found.data_offset = header.header_bytes;
+  found.points = vertices.count;
+  found.record_bytes = offset;
+  found.file_size = size;
+  found.width = static_cast<std::uint32_t>(vertices.count);
+  found.height = 1;
+  found.xyz_only = vertices.properties.size() == 3 && offset == 12 && found.xyz[0] == 0 &&
+                   found.xyz[1] == 4 && found.xyz[2] == 8;
+  found.ply = 1;
+  layout = found;
+  fields = names;
+  return true;
+}
+
+bool describeBinaryCloud(const std::string &path, BinaryCloudLayout &layout, std::string &fields) {
+  fields.clear();
+  const std::string extension = pcl_ms::fileExtension(path);
+  if (extension == ".pcd")
+    return describeBinaryPcd(path, layout, fields);
+  if (extension == ".ply")
+    return describeBinaryPly(path, layout, fields);
+  return false;
+}
+
 bool readRecords(const std::string &path, const BinaryCloudLayout &layout, std::uint64_t begin,
                  std::uint64_t end, std::vector<unsigned char> &bytes, std::string &error) {
   bytes.clear();
@@ -89,9 +196,11 @@ bool readRecords(const std::string &path, const BinaryCloudLayout &layout, std::
     return false;
   }
   if (last > size) {
-    error = path + ": truncated PCD file: points " + std::to_string(begin) + " to " +
-            std::to_string(end) + " need bytes " + std::to_string(first) + " to " +
-            std::to_string(last) + ", the file ends at byte " + std::to_string(size);
+    error = path +
+            (layout.ply ? ": truncated PLY file: points " : ": truncated PCD file: points ") +
+            std::to_string(begin) + " to " + std::to_string(end) + " need bytes " +
+            std::to_string(first) + " to " + std::to_string(last) + ", the file ends at byte " +
+            std::to_string(size);
     return false;
   }
   bytes.resize(last - first);

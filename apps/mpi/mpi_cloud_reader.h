@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Reading one binary PCD file across the ranks of an MPI job: rank 0 reads
-// the header, every rank reads the records of its own byte range, and the
-// ranks then share them (docs/algorithm.md, "Across processes"). Files this
-// does not recognise (ASCII or compressed PCD, PLY, the other formats) are
-// left to rank 0's ordinary reader, which checks them in full.
+// Reading one binary PCD or PLY file across the ranks of an MPI job: rank 0
+// reads the header, every rank reads the records of its own byte range, and
+// the ranks then share them (docs/algorithm.md, "Across processes"). Files
+// this does not recognise (ASCII or compressed PCD, ASCII or big-endian PLY,
+// the other formats) are left to rank 0's ordinary reader, which checks them
+// in full.
 #pragma once
 
 #include <mpi.h>
@@ -15,7 +16,7 @@
 
 namespace pcl_ms_mpi {
 
-/// Where the points of a binary PCD file are. Plain data: rank 0 fills it
+/// Where the points of a binary PCD or PLY file are. Plain data: rank 0 fills it
 /// and broadcasts it as bytes.
 struct BinaryCloudLayout {
   std::uint64_t data_offset = 0; // the first record's byte
@@ -27,6 +28,7 @@ struct BinaryCloudLayout {
   std::array<std::int32_t, 3> normal = {-1, -1, -1}; // normal_x, _y, _z, or -1
   std::int32_t xyz_only = 0;                         // fields are exactly x y z (12 bytes)
   std::array<float, 3> origin = {0, 0, 0};           // VIEWPOINT translation
+  std::int32_t ply = 0;                              // a PLY file, not a PCD
   bool hasNormals() const { return normal[0] >= 0 && normal[1] >= 0 && normal[2] >= 0; }
 };
 
@@ -36,6 +38,17 @@ struct BinaryCloudLayout {
 /// False otherwise: the caller then reads the file the ordinary way, which
 /// gives the precise error for a bad header.
 bool describeBinaryPcd(const std::string &path, BinaryCloudLayout &layout, std::string &fields);
+
+/// Likewise for a binary_little_endian PLY file whose first element is the
+/// vertices, of fixed-size properties only, among them single floats x, y
+/// and z (normals, as nx or normal_x..., used if present), followed by
+/// fixed-size elements only (a cloud, not a mesh with faces). Files with
+/// obj_info lines or a range_grid, whose clouds PCL's reader reshapes, are
+/// left to rank 0's reader.
+bool describeBinaryPly(const std::string &path, BinaryCloudLayout &layout, std::string &fields);
+
+/// describeBinaryPcd or describeBinaryPly, by the file's extension.
+bool describeBinaryCloud(const std::string &path, BinaryCloudLayout &layout, std::string &fields);
 
 /// The records [begin, end) of rank `rank`'s byte range: `end - begin`
 /// records of layout.record_bytes each. False, with the reason, when the

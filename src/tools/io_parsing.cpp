@@ -234,6 +234,7 @@ bool parsePlyHeader(std::istream &in, PlyHeader &header, std::string &error) {
       error = where + "obj_info must start the line";
       return false;
     } else if (key == "comment" || key == "obj_info") {
+      header.has_obj_info |= key == "obj_info";
       continue;
     } else if (key == "format") {
       if (words.size() < 2) {

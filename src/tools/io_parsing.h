@@ -107,6 +107,8 @@ struct PlyHeader {
   PlyFormat format = PlyFormat::Ascii;
   std::vector<PlyElement> elements;
   std::uint64_t header_bytes = 0;
+  /// PCL's reader takes a cloud's width and height from obj_info lines.
+  bool has_obj_info = false;
 
   const PlyElement *find(const std::string &name) const {
     for (const PlyElement &element : elements)

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
-# Usage: bad_region.sh BUILD_DIR MPIEXEC RANKS BINARY_PCD
-# Each rank reads its own byte range of a binary PCD. With the file's last
+# Usage: bad_region.sh BUILD_DIR MPIEXEC RANKS BINARY_PCD_OR_PLY
+# Each rank reads its own byte range of a binary PCD or PLY (a PLY mesh is
+# first written as a cloud, its vertices alone). With the file's last
 # records cut off, only the last rank's range is bad: that rank must say so
 # (naming itself and the file), the others must not claim an error of their
 # own, every rank must exit with 2 (file error), quickly, and no mesh may be
@@ -10,18 +11,23 @@ set -euo pipefail
 build=$1 mpiexec=$2 ranks=$3 input=$4
 source "$(dirname "${BASH_SOURCE[0]}")/job_setup.sh"
 
+ext=${input##*.}
+if [[ $ext == ply ]]; then
+  python3 "$(dirname "${BASH_SOURCE[0]}")/ply_cloud.py" "$input" "$work/cloud.ply"
+  input=$work/cloud.ply
+fi
 # 100 bytes fewer: part of the last record or records, none of the others'.
-head -c $(($(stat -c %s "$input") - 100)) "$input" > "$work/cut.pcd"
+head -c $(($(stat -c %s "$input") - 100)) "$input" > "$work/cut.$ext"
 started=$SECONDS
 "$mpiexec" "${mpirun_flags[@]}" -np "$ranks" bash -c \
   '"$0" "$1" "$2" -bucket_points 4000; echo "$?" > "$3/exit.$OMPI_COMM_WORLD_RANK"' \
-  "$build/pcl_ms_reconstruct_mpi" "$work/cut.pcd" "$work/out.ply" "$work" \
+  "$build/pcl_ms_reconstruct_mpi" "$work/cut.$ext" "$work/out.ply" "$work" \
   > "$work/stdout.txt" 2> "$work/stderr.txt" || true
 took=$((SECONDS - started))
 cat "$work/stderr.txt"
 [[ -e $work/out.ply ]] && { echo "FAIL: a mesh was written"; exit 1; }
 last=$((ranks - 1))
-grep -q "^error: \(rank $last: \)\?.*cut.pcd: truncated PCD file" "$work/stderr.txt" ||
+grep -q "^error: \(rank $last: \)\?.*cut.$ext: truncated ${ext^^} file" "$work/stderr.txt" ||
   { echo "FAIL: no 'error:' line from rank $last naming the file"; exit 1; }
 if ((ranks > 1)) && grep -v "rank $last:" "$work/stderr.txt" | grep -q '^error:'; then
   echo "FAIL: a rank whose range is whole reported an error"

@@ -3,7 +3,8 @@
 # Usage: same_mesh.sh BUILD_DIR MPIEXEC RANKS INPUT [options...]
 # pcl_ms_reconstruct_mpi on RANKS ranks must write the same mesh, byte for
 # byte, as pcl_ms_reconstruct with the same options. MESH_EXTENSION (default
-# ply) picks the output format.
+# ply) picks the output format; READ_IN_PARTS=1 asks that every rank read its
+# own part of the input.
 set -euo pipefail
 build=$1 mpiexec=$2 ranks=$3 input=$4
 shift 4
@@ -23,6 +24,12 @@ if [[ -z $seams || $seams -lt 3 ]]; then
   cat "$work/log.txt"
   echo "FAIL: expected at least 3 seam zones, got '${seams}'"
   exit 1
+fi
+if [[ ${READ_IN_PARTS:-0} == 1 ]]; then
+  parts="$ranks parts"
+  ((ranks == 1)) && parts="1 part"
+  grep -q "points, $parts\]" "$work/log.txt" ||
+    { cat "$work/log.txt"; echo "FAIL: the input was not read in $parts"; exit 1; }
 fi
 # Every rank reported its peak memory.
 reported=$(grep -cE '^ *[0-9]+( +[0-9.]+){6} *$' "$work/log.txt" || true)
