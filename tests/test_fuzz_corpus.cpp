@@ -10,6 +10,7 @@
 // they are while fuzzing (a broken promise aborts), without the entry point
 // libFuzzer calls.
 #define PCL_MS_FUZZ_REPLAY
+#include "fuzz/binary_layout_fuzzer.cpp"
 #include "fuzz/mesh_quality_fuzzer.cpp"
 #include "fuzz/reconstruct_fuzzer.cpp"
 #include "fuzz/reconstruct_inputs_fuzzer.cpp"
@@ -56,6 +57,10 @@ TEST(FuzzCorpus, ReconstructWithEveryOptionalInputRunsToAMeshOrAnError) {
 
 TEST(FuzzCorpus, MeshMetricsAreConsistentOnEveryPairOfMeshes) {
   replayCorpus("mesh_quality", &pcl_ms_fuzz::meshQualityOneInput);
+}
+
+TEST(FuzzCorpus, BinaryCloudsReadInPartsAreTheOrdinaryReadersPoints) {
+  replayCorpus("binary_layout", &pcl_ms_fuzz::binaryLayoutOneInput);
 }
 
 class FuzzCorpusReaders : public TempDirTest {};

@@ -7,8 +7,6 @@
 // in full.
 #pragma once
 
-#include <mpi.h>
-
 #include <array>
 #include <cstdint>
 #include <string>
