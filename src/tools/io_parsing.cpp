@@ -237,8 +237,18 @@ bool parsePlyHeader(std::istream &in, PlyHeader &header, std::string &error) {
       header.has_obj_info |= key == "obj_info";
       continue;
     } else if (key == "format") {
+      // PCL's parser takes one format line, of three words, version 1.0.
       if (words.size() < 2) {
         error = where + "missing format";
+        return false;
+      }
+      if (has_format) {
+        error = where + "a second format line";
+        return false;
+      }
+      if (words.size() != 3 || words[2] != "1.0") {
+        error = where + "PLY version " + printable(words.size() > 2 ? words[2] : "(none)") +
+                " is not supported (1.0 only)";
         return false;
       }
       if (words[1] == "ascii")
@@ -259,6 +269,10 @@ bool parsePlyHeader(std::istream &in, PlyHeader &header, std::string &error) {
         return false;
       }
       element.name = std::string(words[1]);
+      if (header.find(element.name)) {
+        error = where + "element " + printable(words[1]) + " is declared twice";
+        return false;
+      }
       header.elements.push_back(std::move(element));
     } else if (key == "property") {
       if (header.elements.empty()) {
@@ -281,7 +295,13 @@ bool parsePlyHeader(std::istream &in, PlyHeader &header, std::string &error) {
         error = where + "malformed property line";
         return false;
       }
-      header.elements.back().properties.push_back(std::move(property));
+      std::vector<PlyProperty> &properties = header.elements.back().properties;
+      if (std::any_of(properties.begin(), properties.end(),
+                      [&](const PlyProperty &other) { return other.name == property.name; })) {
+        error = where + "property " + printable(property.name) + " is declared twice";
+        return false;
+      }
+      properties.push_back(std::move(property));
     } else {
       error = where + "unknown keyword " + printable(key);
       return false;
