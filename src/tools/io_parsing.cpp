@@ -385,7 +385,7 @@ bool dataReadsAsHeader(std::istream &in, std::string &keyword) {
 bool parsePcdHeader(std::istream &in, PcdHeader &header, std::string &error) {
   header = PcdHeader();
   std::vector<std::string> names, sizes, types, counts;
-  bool has_fields = false, has_size = false, has_type = false;
+  bool has_fields = false, has_size = false, has_type = false, has_count = false;
   bool has_width = false, has_points = false;
   std::string data_kind;
 
@@ -412,6 +412,11 @@ bool parsePcdHeader(std::istream &in, PcdHeader &header, std::string &error) {
           "PCD header line " + std::to_string(line_number) + ": bad " + std::string(key) + " value";
       return false;
     };
+    const auto declaredTwice = [&]() {
+      error = "PCD header line " + std::to_string(line_number) + ": a second " + std::string(key) +
+              " line";
+      return false;
+    };
     const auto parseCount = [&](std::uint64_t &count) {
       return words.size() == 2 && parseInteger(words[1], count);
     };
@@ -424,16 +429,25 @@ bool parsePcdHeader(std::istream &in, PcdHeader &header, std::string &error) {
         if (!parseDouble(words[k + 1], header.viewpoint[k]))
           return badValue();
     } else if (key == "FIELDS" || key == "COLUMNS") {
+      if (has_fields)
+        return declaredTwice();
       names = values();
       has_fields = true;
-    } else if (key == "SIZE") {
-      sizes = values();
-      has_size = true;
-    } else if (key == "TYPE") {
-      types = values();
-      has_type = true;
-    } else if (key == "COUNT") {
-      counts = values();
+    } else if (key == "SIZE" || key == "TYPE" || key == "COUNT") {
+      // PCL's reader checks each of these lines against the FIELDS line
+      // read before it, so they must follow it.
+      std::vector<std::string> &list = key == "SIZE" ? sizes : key == "TYPE" ? types : counts;
+      bool &seen = key == "SIZE" ? has_size : key == "TYPE" ? has_type : has_count;
+      if (seen)
+        return declaredTwice();
+      if (words.size() - 1 != names.size()) {
+        error = "PCD header line " + std::to_string(line_number) + ": " + std::string(key) +
+                " lists " + std::to_string(words.size() - 1) + " entries, FIELDS before it " +
+                std::to_string(names.size());
+        return false;
+      }
+      list = values();
+      seen = true;
     } else if (key == "WIDTH") {
       if (!parseCount(header.width))
         return badValue();
