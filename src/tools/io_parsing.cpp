@@ -37,20 +37,34 @@ std::string_view trim(std::string_view text) {
   return text;
 }
 
-std::vector<std::string_view> splitWords(std::string_view text) {
+namespace {
+
+/// The words of `text` between separators.
+template <typename Separates>
+std::vector<std::string_view> splitAt(std::string_view text, Separates separates) {
   std::vector<std::string_view> words;
   std::size_t i = 0;
   while (i < text.size()) {
-    while (i < text.size() && isBlank(text[i]))
+    while (i < text.size() && separates(text[i]))
       ++i;
     const std::size_t start = i;
-    while (i < text.size() && !isBlank(text[i]))
+    while (i < text.size() && !separates(text[i]))
       ++i;
     if (i > start)
       words.push_back(text.substr(start, i - start));
   }
   return words;
 }
+
+/// Words as PCL's PCD reader splits a header line: at spaces, tabs and
+/// carriage returns only (a vertical tab or form feed is part of a word).
+std::vector<std::string_view> splitPcdWords(std::string_view text) {
+  return splitAt(text, [](char c) { return c == ' ' || c == '\t' || c == '\r'; });
+}
+
+} // namespace
+
+std::vector<std::string_view> splitWords(std::string_view text) { return splitAt(text, isBlank); }
 
 bool startsWith(std::string_view text, std::string_view prefix) {
   return text.substr(0, prefix.size()) == prefix;
@@ -404,7 +418,7 @@ bool parsePcdHeader(std::istream &in, PcdHeader &header, std::string &error) {
     }
     if (text.empty() || text.front() == '#')
       continue;
-    const std::vector<std::string_view> words = splitWords(text);
+    const std::vector<std::string_view> words = splitPcdWords(text);
     const std::string_view key = words.front();
     const auto values = [&]() { return std::vector<std::string>(words.begin() + 1, words.end()); };
     const auto badValue = [&]() {
