@@ -325,7 +325,12 @@ bool parsePlyHeader(std::istream &in, PlyHeader &header, std::string &error) {
     error = "PLY header has no format line";
     return false;
   }
-  header.header_bytes = static_cast<std::uint64_t>(in.tellg());
+  const std::streampos data_begins = in.tellg();
+  if (data_begins < 0) { // end_header ends the file without a line break
+    error = "truncated PLY file: the header's last line is cut short";
+    return false;
+  }
+  header.header_bytes = static_cast<std::uint64_t>(data_begins);
   return true;
 }
 
