@@ -20,6 +20,7 @@
 #include "tool_support.h"
 
 #include <pcl_ms/io.h>
+#include <pcl_ms/medial_scaffold_reconstruction.h>
 #include <pcl_ms/reconstruct.h>
 
 #include <pcl/conversions.h>
@@ -189,6 +190,30 @@ void returnFreeMemory() {
 #endif
 }
 
+/// Rank 0 with initial triangles: they are honoured by the one-piece path
+/// only, so rank 0 meshes the cloud alone, as pcl_ms_reconstruct does,
+/// through the same PCL class.
+template <typename PointT>
+pcl_ms::Result meshWithInitialTriangles(const Job &job, pcl::PointCloud<PointT> &&points,
+                                        const pcl_ms::Parameters &parameters,
+                                        const std::vector<pcl::Vertices> &initial) {
+  pcl::MedialScaffoldReconstruction<PointT> reconstruction;
+  reconstruction.setInputCloud(pcl::make_shared<pcl::PointCloud<PointT>>(std::move(points)));
+  reconstruction.setParameters(parameters);
+  reconstruction.setInitialTriangles(initial);
+  reconstruction.setUseSensorOrigin(false); // run() decided the viewpoint
+  pcl::PointCloud<PointT> copy;
+  std::vector<pcl::Vertices> polygons;
+  {
+    SilencePclMessages silence;
+    reconstruction.reconstruct(copy, polygons);
+  }
+  if (!reconstruction.getErrorMessage().empty())
+    abortJob(job, kReconstructionFailure,
+             "reconstruction failed: " + reconstruction.getErrorMessage());
+  return reconstruction.getResult();
+}
+
 /// Rank 0: meshes `points`, with the other ranks meshing the units it
 /// hands out, and frees them as soon as the core has prepared its copy.
 template <typename PointT>
@@ -231,7 +256,8 @@ struct Input {
 template <typename PointT>
 int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &options,
                     pcl_ms::Parameters parameters, const Input &input, pcl::PCLPointCloud2 &cloud,
-                    const std::string &fields, double load_ms) {
+                    const std::vector<pcl::Vertices> &initial, const std::string &fields,
+                    double load_ms) {
   const bool on_rank_zero = job.rank == 0;
   const bool verbose = on_rank_zero && !options.quiet;
   pcl::PointCloud<PointT> points;
@@ -304,7 +330,9 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
       std::fprintf(stderr, "  all ranks: %s done, %.1f s elapsed\n", stage.c_str(),
                    secondsSinceStart());
   });
-  pcl_ms::Result result = meshPoints(job, std::move(points), parameters, exchange);
+  pcl_ms::Result result =
+      initial.empty() ? meshPoints(job, std::move(points), parameters, exchange)
+                      : meshWithInitialTriangles(job, std::move(points), parameters, initial);
   exchange.release(); // the other ranks are done
   const double reconstruct_seconds = secondsSinceStart();
   if (verbose) {
@@ -404,16 +432,13 @@ int run(const Job &job, int argc, char **argv) {
                    "with the same triangles as pcl_ms_reconstruct given the same options.");
     return kSuccess;
   }
-  if (!options.initial.empty()) {
-    error = "-initial is not supported across processes: use pcl_ms_reconstruct";
-    return on_rank_zero ? fail(kBadArguments, error) : kBadArguments;
-  }
   pcl_ms::Parameters parameters;
   if (const std::string reason = pcl_ms_tools::reconstructParameters(options, parameters);
       !reason.empty())
     return on_rank_zero ? fail(kBadArguments, reason) : kBadArguments;
 
   pcl::PCLPointCloud2 cloud;
+  std::vector<pcl::Vertices> initial; // rank 0's, from -initial
   Input input;
   std::string fields;
   double load_ms = 0;
@@ -423,8 +448,9 @@ int run(const Job &job, int argc, char **argv) {
     if (status == kSuccess)
       status = pcl_ms_tools::checkMedialAxisOutput(options.medial_axis, error);
     // A binary PCD or PLY is read in parts, unless normals are to be estimated
-    // (on the whole cloud) or asked for and absent (the loader says so).
-    if (status == kSuccess && options.estimate_normals == 0 &&
+    // (on the whole cloud) or asked for and absent (the loader says so), or
+    // initial triangles are given (rank 0 meshes them in one piece).
+    if (status == kSuccess && options.estimate_normals == 0 && options.initial.empty() &&
         pcl_ms_mpi::describeBinaryCloud(options.input, input.layout, fields) &&
         (!options.normals || input.layout.hasNormals())) {
       input.in_parts = 1;
@@ -438,6 +464,8 @@ int run(const Job &job, int argc, char **argv) {
       }
     } else if (status == kSuccess) {
       status = pcl_ms_tools::loadReconstructInput(options, parameters, cloud, load_ms, error);
+      if (status == kSuccess && !options.initial.empty())
+        status = pcl_ms_tools::loadInitialTriangles(options, cloud, initial, error);
     }
   }
   status = statusOfRankZero(job, status);
@@ -454,9 +482,9 @@ int run(const Job &job, int argc, char **argv) {
     parameters.viewpoint = {{viewpoint[1], viewpoint[2], viewpoint[3]}};
 
   return parameters.use_normals ? loadMeshAndSave<pcl::PointNormal>(job, options, parameters, input,
-                                                                    cloud, fields, load_ms)
+                                                                    cloud, initial, fields, load_ms)
                                 : loadMeshAndSave<pcl::PointXYZ>(job, options, parameters, input,
-                                                                 cloud, fields, load_ms);
+                                                                 cloud, initial, fields, load_ms);
 }
 
 } // namespace
