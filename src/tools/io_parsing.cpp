@@ -224,7 +224,9 @@ std::size_t plyTypeSize(PlyType type) {
 
 bool parsePlyHeader(std::istream &in, PlyHeader &header, std::string &error) {
   std::string line;
-  if (!readHeaderLine(in, line, kMaxHeaderLine) || trim(line) != "ply") {
+  // PCL's parser reads the magic from the file's first three bytes.
+  if (!readHeaderLine(in, line, kMaxHeaderLine) || !startsWith(line, "ply") ||
+      trim(line) != "ply") {
     error = "not a PLY file (no 'ply' magic line)";
     return false;
   }
