@@ -456,11 +456,17 @@ bool parsePcdHeader(std::istream &in, PcdHeader &header, std::string &error) {
       has_fields = true;
     } else if (key == "SIZE" || key == "TYPE" || key == "COUNT") {
       // PCL's reader checks each of these lines against the FIELDS line
-      // read before it, so they must follow it.
+      // read before it, so they must follow it, in this order: TYPE after
+      // SIZE, COUNT after both.
       std::vector<std::string> &list = key == "SIZE" ? sizes : key == "TYPE" ? types : counts;
       bool &seen = key == "SIZE" ? has_size : key == "TYPE" ? has_type : has_count;
       if (seen)
         return declaredTwice();
+      if ((key != "SIZE" && !has_size) || (key == "COUNT" && !has_type)) {
+        error = "PCD header line " + std::to_string(line_number) + ": " + std::string(key) +
+                (key == "TYPE" ? " before SIZE" : " before SIZE and TYPE");
+        return false;
+      }
       if (words.size() - 1 != names.size()) {
         error = "PCD header line " + std::to_string(line_number) + ": " + std::string(key) +
                 " lists " + std::to_string(words.size() - 1) + " entries, FIELDS before it " +
@@ -477,6 +483,10 @@ bool parsePcdHeader(std::istream &in, PcdHeader &header, std::string &error) {
       if (!parseCount(header.height))
         return badValue();
     } else if (key == "POINTS") {
+      if (!has_fields) { // PCL's reader sizes the data from the fields here
+        error = "PCD header line " + std::to_string(line_number) + ": POINTS before FIELDS";
+        return false;
+      }
       if (!parseCount(header.points))
         return badValue();
       has_points = true;
