@@ -101,12 +101,20 @@ inline int binaryLayoutOneInput(const std::uint8_t *data, std::size_t size) {
     broken("the ordinary reader finds as many points");
   const int axes[3] = {floatFieldOffset(cloud, "x"), floatFieldOffset(cloud, "y"),
                        floatFieldOffset(cloud, "z")};
+  const int normals[3] = {floatFieldOffset(cloud, "normal_x"), floatFieldOffset(cloud, "normal_y"),
+                          floatFieldOffset(cloud, "normal_z")};
   for (std::uint64_t i = 0; i < layout.points; ++i)
-    for (int k = 0; k < 3; ++k)
-      if (axes[k] < 0 ||
-          floatBits(&cloud.data[i * cloud.point_step + static_cast<std::size_t>(axes[k])]) !=
-              floatBits(&all[i * record + layout.xyz[k]]))
+    for (int k = 0; k < 3; ++k) {
+      const std::uint8_t *point = &cloud.data[i * cloud.point_step];
+      if (axes[k] < 0 || floatBits(point + axes[k]) != floatBits(&all[i * record + layout.xyz[k]]))
         broken("the points read in parts are the ordinary reader's, bit for bit");
+      // The tool reads normals in parts only when all three are there.
+      if (layout.hasNormals() &&
+          (normals[k] < 0 ||
+           floatBits(point + normals[k]) !=
+               floatBits(&all[i * record + static_cast<std::uint32_t>(layout.normal[k])])))
+        broken("the normals read in parts are the ordinary reader's, bit for bit");
+    }
   return 0;
 }
 
