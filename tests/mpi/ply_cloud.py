@@ -23,12 +23,15 @@ def main(source, target, camera):
     lines = data[:end].decode("ascii").splitlines()
     if "format binary_little_endian 1.0" not in lines:
         sys.exit(f"{source}: not a binary little-endian PLY file")
-    header, count, record, in_vertex = [], 0, 0, False
+    header, count, record, in_vertex, elements = [], 0, 0, False, 0
     for line in lines:
-        words = line.split()
+        words = line.split() or [""]
         if words[0] == "element":
+            elements += 1
             in_vertex = words[1] == "vertex"
             if in_vertex:
+                if elements != 1:
+                    sys.exit(f"{source}: the vertices are not the first element")
                 count = int(words[2])
         elif words[0] == "property" and in_vertex:
             if words[1] == "list":
