@@ -438,8 +438,10 @@ bool parsePcdHeader(std::istream &in, PcdHeader &header, std::string &error) {
               " line";
       return false;
     };
+    // PCL's reader holds these counts in 32 bits and refuses a WIDTH or
+    // HEIGHT beyond them even when a later line corrects it.
     const auto parseCount = [&](std::uint64_t &count) {
-      return words.size() == 2 && parseInteger(words[1], count);
+      return words.size() == 2 && parseInteger(words[1], count) && count <= UINT32_MAX;
     };
     if (key == "VERSION") {
       continue;
@@ -550,9 +552,8 @@ bool parsePcdHeader(std::istream &in, PcdHeader &header, std::string &error) {
     header.values_per_point += field.count;
     header.fields.push_back(field);
   }
-  // WIDTH and HEIGHT are 32-bit in PCL; their product must not wrap either.
-  if (header.width > UINT32_MAX || header.height > UINT32_MAX ||
-      header.width * header.height != header.points) {
+  // WIDTH and HEIGHT are 32-bit (parseCount), so their product cannot wrap.
+  if (header.width * header.height != header.points) {
     error = "PCD header: WIDTH x HEIGHT (" + std::to_string(header.width) + " x " +
             std::to_string(header.height) + ") differs from POINTS (" +
             std::to_string(header.points) + ")";
