@@ -82,6 +82,49 @@ bool describeBinaryPcd(const std::string &path, BinaryCloudLayout &layout, std::
   return true;
 }
 
+namespace {
+
+/// The cloud's width and height as PCL's reader and pcl_ms::loadPointCloud
+/// leave them: a camera element's int viewportx and viewporty (its last
+/// record's) replace the vertex count and 1, and a cloud whose width times
+/// height is not the vertex count is made one row again. False if the
+/// camera's bytes cannot be read.
+bool readViewport(std::istream &in, const PlyHeader &header, std::uint64_t vertices_end,
+                  std::uint32_t &width, std::uint32_t &height) {
+  const std::uint64_t points = header.elements.front().count;
+  std::uint64_t viewport[2] = {points, 1};
+  std::uint64_t element_begin = vertices_end;
+  for (std::size_t e = 1; e < header.elements.size(); ++e) {
+    const PlyElement &element = header.elements[e];
+    std::uint64_t record = 0;
+    for (const PlyProperty &property : element.properties)
+      record += pcl_ms::io_detail::plyTypeSize(property.value_type);
+    if (element.name == "camera" && element.count > 0) {
+      std::uint64_t property_offset = 0;
+      for (const PlyProperty &property : element.properties) {
+        const int axis = property.name == "viewportx" ? 0 : property.name == "viewporty" ? 1 : -1;
+        if (axis >= 0 && property.value_type == PlyType::Int32) {
+          std::int32_t value = 0;
+          in.clear();
+          if (!in.seekg(static_cast<std::streamoff>(element_begin + (element.count - 1) * record +
+                                                    property_offset)) ||
+              !in.read(reinterpret_cast<char *>(&value), sizeof value))
+            return false;
+          viewport[axis] = static_cast<std::uint32_t>(value);
+        }
+        property_offset += pcl_ms::io_detail::plyTypeSize(property.value_type);
+      }
+    }
+    element_begin += record * element.count;
+  }
+  const bool rows = viewport[0] * viewport[1] == points;
+  width = static_cast<std::uint32_t>(rows ? viewport[0] : points);
+  height = static_cast<std::uint32_t>(rows ? viewport[1] : 1);
+  return true;
+}
+
+} // namespace
+
 bool describeBinaryPly(const std::string &path, BinaryCloudLayout &layout, std::string &fields) {
   if (!pcl_ms::io_detail::hostIsLittleEndian())
     return false;
@@ -162,8 +205,8 @@ bool describeBinaryPly(const std::string &path, BinaryCloudLayout &layout, std::
   found.points = vertices.count;
   found.record_bytes = offset;
   found.file_size = size;
-  found.width = static_cast<std::uint32_t>(vertices.count);
-  found.height = 1;
+  if (!readViewport(in, header, vertices_end, found.width, found.height))
+    return false;
   found.xyz_only = vertices.properties.size() == 3 && offset == 12 && found.xyz[0] == 0 &&
                    found.xyz[1] == 4 && found.xyz[2] == 8;
   found.ply = 1;

@@ -40,9 +40,10 @@ bool describeBinaryPcd(const std::string &path, BinaryCloudLayout &layout, std::
 /// Likewise for a binary_little_endian PLY file whose first element is the
 /// vertices, of fixed-size properties only, among them single floats x, y
 /// and z (normals, as nx or normal_x..., used if present), followed by
-/// fixed-size elements only (a cloud, not a mesh with faces). Files with
-/// obj_info lines or a range_grid, whose clouds PCL's reader reshapes, are
-/// left to rank 0's reader.
+/// fixed-size elements only (a cloud, not a mesh with faces). The camera
+/// element's viewport gives an organized cloud its rows, as PCL's reader
+/// does. Files with obj_info lines or a range_grid, which PCL's reader also
+/// reshapes, are left to rank 0's reader.
 bool describeBinaryPly(const std::string &path, BinaryCloudLayout &layout, std::string &fields);
 
 /// describeBinaryPcd or describeBinaryPly, by the file's extension.

@@ -99,6 +99,8 @@ inline int binaryLayoutOneInput(const std::uint8_t *data, std::size_t size) {
     broken("a file read whole in parts is one the ordinary reader accepts");
   if (std::uint64_t{cloud.width} * cloud.height != layout.points)
     broken("the ordinary reader finds as many points");
+  if (cloud.width != layout.width || cloud.height != layout.height)
+    broken("the ordinary reader sees the same rows (an organized cloud has a viewpoint)");
   const int axes[3] = {floatFieldOffset(cloud, "x"), floatFieldOffset(cloud, "y"),
                        floatFieldOffset(cloud, "z")};
   const int normals[3] = {floatFieldOffset(cloud, "normal_x"), floatFieldOffset(cloud, "normal_y"),
