@@ -8,7 +8,8 @@
 // rank (pcl_ms_mpi::MpiUnitFarm), meshing one itself meanwhile; the other
 // ranks hold one unit at a time, never the cloud (docs/algorithm.md,
 // "Across processes"). Rank 0 finishes the surface (hole filling,
-// orientation) and writes the mesh.
+// orientation) and writes the mesh. With -initial, rank 0 meshes the cloud
+// alone in one piece, as pcl_ms_reconstruct does.
 //
 // Failures: what every rank would see the same way (arguments, the file) is
 // agreed on and every rank exits with the same code; a failure on one rank
@@ -202,11 +203,11 @@ pcl_ms::Result meshWithInitialTriangles(const Job &job, pcl::PointCloud<PointT> 
   reconstruction.setParameters(parameters);
   reconstruction.setInitialTriangles(initial);
   reconstruction.setUseSensorOrigin(false); // run() decided the viewpoint
-  pcl::PointCloud<PointT> copy;
+  pcl::PointCloud<PointT> input_copy;       // this overload of PCL's interface hands the input back
   std::vector<pcl::Vertices> polygons;
   {
     SilencePclMessages silence;
-    reconstruction.reconstruct(copy, polygons);
+    reconstruction.reconstruct(input_copy, polygons);
   }
   if (!reconstruction.getErrorMessage().empty())
     abortJob(job, kReconstructionFailure,
