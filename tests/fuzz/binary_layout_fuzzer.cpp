@@ -5,8 +5,8 @@
 // z (and the normals) inside each record; three ranks' byte ranges must
 // each be read whole or refused with a reason; and a file read whole in
 // parts must be one the ordinary reader (pcl_ms::loadPointCloud) accepts,
-// with the same points, bit for bit: ranks and one process mesh the same
-// cloud.
+// with the same points and normals, bit for bit, and the same width and
+// height: ranks and one process mesh the same cloud from the same viewpoint.
 #include "fuzz_bytes.h"
 #include "mpi_cloud_reader.h"
 
