@@ -24,15 +24,10 @@ using pcl_ms::io_detail::PlyHeader;
 using pcl_ms::io_detail::PlyProperty;
 using pcl_ms::io_detail::PlyType;
 
-bool describeBinaryPcd(const std::string &path, BinaryCloudLayout &layout, std::string &fields) {
-  // PCD binary data is the writer's memory: little-endian in practice.
-  if (!pcl_ms::io_detail::hostIsLittleEndian())
-    return false;
-  std::error_code code;
-  const std::uintmax_t size = std::filesystem::file_size(path, code);
-  if (code)
-    return false;
-  std::ifstream in(path, std::ios::binary);
+namespace {
+
+bool describeBinaryPcd(std::istream &in, std::uintmax_t size, BinaryCloudLayout &layout,
+                       std::string &fields) {
   PcdHeader header;
   std::string ignored;
   if (!pcl_ms::io_detail::parsePcdHeader(in, header, ignored) || header.data != PcdData::Binary ||
@@ -82,8 +77,6 @@ bool describeBinaryPcd(const std::string &path, BinaryCloudLayout &layout, std::
   return true;
 }
 
-namespace {
-
 /// The cloud's width and height as PCL's reader and pcl_ms::loadPointCloud
 /// leave them: a camera element's int viewportx and viewporty (its last
 /// record's) replace the vertex count and 1, and a cloud whose width times
@@ -123,16 +116,8 @@ bool readViewport(std::istream &in, const PlyHeader &header, std::uint64_t verti
   return true;
 }
 
-} // namespace
-
-bool describeBinaryPly(const std::string &path, BinaryCloudLayout &layout, std::string &fields) {
-  if (!pcl_ms::io_detail::hostIsLittleEndian())
-    return false;
-  std::error_code code;
-  const std::uintmax_t size = std::filesystem::file_size(path, code);
-  if (code)
-    return false;
-  std::ifstream in(path, std::ios::binary);
+bool describeBinaryPly(std::istream &in, std::uintmax_t size, BinaryCloudLayout &layout,
+                       std::string &fields) {
   PlyHeader header;
   std::string ignored;
   if (!pcl_ms::io_detail::parsePlyHeader(in, header, ignored) ||
@@ -215,13 +200,24 @@ bool describeBinaryPly(const std::string &path, BinaryCloudLayout &layout, std::
   return true;
 }
 
+} // namespace
+
 bool describeBinaryCloud(const std::string &path, BinaryCloudLayout &layout, std::string &fields) {
   fields.clear();
+  // Binary PCD data is the writer's memory, little-endian in practice; only
+  // little-endian PLY is read in parts.
+  if (!pcl_ms::io_detail::hostIsLittleEndian())
+    return false;
+  std::error_code code;
+  const std::uintmax_t size = std::filesystem::file_size(path, code);
+  if (code)
+    return false;
+  std::ifstream in(path, std::ios::binary);
   const std::string extension = pcl_ms::fileExtension(path);
   if (extension == ".pcd")
-    return describeBinaryPcd(path, layout, fields);
+    return describeBinaryPcd(in, size, layout, fields);
   if (extension == ".ply")
-    return describeBinaryPly(path, layout, fields);
+    return describeBinaryPly(in, size, layout, fields);
   return false;
 }
 

@@ -30,23 +30,19 @@ struct BinaryCloudLayout {
   bool hasNormals() const { return normal[0] >= 0 && normal[1] >= 0 && normal[2] >= 0; }
 };
 
-/// True when `path` is a PCD file with DATA binary, whose x, y and z (and
-/// normal_x, normal_y, normal_z, if present) are single 4-byte floats, and
-/// the header is one this reader understands; `fields` gets the field names.
-/// False otherwise: the caller then reads the file the ordinary way, which
-/// gives the precise error for a bad header.
-bool describeBinaryPcd(const std::string &path, BinaryCloudLayout &layout, std::string &fields);
-
-/// Likewise for a binary_little_endian PLY file whose first element is the
-/// vertices, of fixed-size properties only, among them single floats x, y
-/// and z (normals, as nx or normal_x..., used if present), followed by
-/// fixed-size elements only (a cloud, not a mesh with faces). The camera
-/// element's viewport gives an organized cloud its rows, as PCL's reader
-/// does. Files with obj_info lines or a range_grid, which PCL's reader also
-/// reshapes, are left to rank 0's reader.
-bool describeBinaryPly(const std::string &path, BinaryCloudLayout &layout, std::string &fields);
-
-/// describeBinaryPcd or describeBinaryPly, by the file's extension.
+/// True when `path` is a binary cloud this reader understands, read in parts:
+/// - a PCD file (`.pcd`) with DATA binary, whose x, y and z (and normal_x,
+///   normal_y, normal_z, if present) are single 4-byte floats;
+/// - a binary_little_endian PLY file (`.ply`) whose first element is the
+///   vertices, of fixed-size properties only, among them single floats x, y
+///   and z (normals, as nx or normal_x..., used if present), followed by
+///   fixed-size elements only (a cloud, not a mesh with faces). The camera
+///   element's viewport gives an organized cloud its rows, as PCL's reader
+///   does. Files with obj_info lines or a range_grid, which PCL's reader
+///   also reshapes, are not read in parts.
+/// `fields` gets the field names. False otherwise: the caller then reads
+/// the file the ordinary way, which gives the precise error for a bad
+/// header.
 bool describeBinaryCloud(const std::string &path, BinaryCloudLayout &layout, std::string &fields);
 
 /// The records [begin, end) of rank `rank`'s byte range: `end - begin`
