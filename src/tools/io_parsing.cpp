@@ -29,15 +29,20 @@ bool isBlank(char c) {
   return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f';
 }
 
-std::string_view trim(std::string_view text) {
-  while (!text.empty() && isBlank(text.front()))
+namespace {
+
+/// `text` without the leading and trailing characters `is_blank` names.
+template <typename IsBlank> std::string_view trimmed(std::string_view text, IsBlank is_blank) {
+  while (!text.empty() && is_blank(text.front()))
     text.remove_prefix(1);
-  while (!text.empty() && isBlank(text.back()))
+  while (!text.empty() && is_blank(text.back()))
     text.remove_suffix(1);
   return text;
 }
 
-namespace {
+/// Blanks as PCL's PCD reader sees them in a header line: spaces, tabs and
+/// carriage returns only (a vertical tab or form feed is part of a word).
+bool isPcdBlank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
 
 /// The words of `text` between separators.
 template <typename Separates>
@@ -56,13 +61,14 @@ std::vector<std::string_view> splitAt(std::string_view text, Separates separates
   return words;
 }
 
-/// Words as PCL's PCD reader splits a header line: at spaces, tabs and
-/// carriage returns only (a vertical tab or form feed is part of a word).
+/// Words as PCL's PCD reader splits a header line (isPcdBlank).
 std::vector<std::string_view> splitPcdWords(std::string_view text) {
-  return splitAt(text, [](char c) { return c == ' ' || c == '\t' || c == '\r'; });
+  return splitAt(text, isPcdBlank);
 }
 
 } // namespace
+
+std::string_view trim(std::string_view text) { return trimmed(text, isBlank); }
 
 std::vector<std::string_view> splitWords(std::string_view text) { return splitAt(text, isBlank); }
 
@@ -417,7 +423,7 @@ bool parsePcdHeader(std::istream &in, PcdHeader &header, std::string &error) {
       error = line_number <= 1 ? "not a PCD file" : "incomplete PCD header (no DATA line)";
       return false;
     }
-    const std::string_view text = trim(line);
+    const std::string_view text = trimmed(line, isPcdBlank);
     if (text.empty() && !line.empty()) {
       // PCL's reader skips empty lines but crashes after one of blanks only.
       error = "PCD header line " + std::to_string(line_number) + " holds only blanks";
