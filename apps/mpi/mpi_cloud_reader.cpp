@@ -168,7 +168,8 @@ bool describeBinaryPly(std::istream &in, std::uintmax_t size, BinaryCloudLayout 
   // What follows the vertices must be of fixed size (PCL's camera element,
   // not faces), so that a file cut short after the vertices is noticed too:
   // then rank 0's reader reports it. A file cut within the vertices is
-  // reported by the rank whose range is missing, as for a PCD.
+  // reported by the rank whose range is missing, as for a PCD (by rank 0's
+  // reader if the cut-off camera holds a viewport to read).
   std::uint64_t after_vertices = 0;
   for (std::size_t e = 1; e < header.elements.size(); ++e) {
     std::uint64_t record = 0;
