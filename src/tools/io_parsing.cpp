@@ -333,6 +333,14 @@ bool parsePlyHeader(std::istream &in, PlyHeader &header, std::string &error) {
     error = "PLY header has no format line";
     return false;
   }
+  // Records without properties hold nothing, yet PCL's parser walks them
+  // one by one: a huge count of them would hang it.
+  for (const PlyElement &element : header.elements)
+    if (element.properties.empty() && element.count > 0) {
+      error = "PLY element " + printable(element.name) + " declares " +
+              std::to_string(element.count) + " records but no properties";
+      return false;
+    }
   const std::streampos data_begins = in.tellg();
   if (data_begins < 0) { // end_header ends the file without a line break
     error = "truncated PLY file: the header's last line is cut short";
