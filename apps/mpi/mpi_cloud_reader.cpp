@@ -77,38 +77,67 @@ bool describeBinaryPcd(std::istream &in, std::uintmax_t size, BinaryCloudLayout 
   return true;
 }
 
+/// Where an element after the vertices starts in the file, and the size of
+/// its records.
+struct ElementSpan {
+  std::uint64_t begin = 0;
+  std::uint64_t record_bytes = 0;
+};
+
+/// The spans of the elements after the vertices (entry e - 1 for element e),
+/// which end at `end`. False when one has a list property (records of
+/// varying size, such as faces) or they cannot all fit in `size` bytes.
+bool spansAfterVertices(const PlyHeader &header, std::uint64_t vertices_end, std::uintmax_t size,
+                        std::vector<ElementSpan> &spans, std::uint64_t &end) {
+  spans.clear();
+  std::uint64_t bytes = 0;
+  for (std::size_t e = 1; e < header.elements.size(); ++e) {
+    ElementSpan span;
+    for (const PlyProperty &property : header.elements[e].properties) {
+      if (property.is_list)
+        return false;
+      span.record_bytes += pcl_ms::io_detail::plyTypeSize(property.value_type);
+    }
+    if (span.record_bytes > 0 && header.elements[e].count > size / span.record_bytes)
+      return false;
+    span.begin = vertices_end + bytes;
+    bytes += span.record_bytes * header.elements[e].count;
+    if (bytes > size)
+      return false;
+    spans.push_back(span);
+  }
+  end = vertices_end + bytes;
+  return true;
+}
+
 /// The cloud's width and height as PCL's reader and pcl_ms::loadPointCloud
 /// leave them: a camera element's int viewportx and viewporty (its last
 /// record's) replace the vertex count and 1, and a cloud whose width times
 /// height is not the vertex count is made one row again. False if the
 /// camera's bytes cannot be read.
-bool readViewport(std::istream &in, const PlyHeader &header, std::uint64_t vertices_end,
+bool readViewport(std::istream &in, const PlyHeader &header, const std::vector<ElementSpan> &spans,
                   std::uint32_t &width, std::uint32_t &height) {
   const std::uint64_t points = header.elements.front().count;
   std::uint64_t viewport[2] = {points, 1};
-  std::uint64_t element_begin = vertices_end;
   for (std::size_t e = 1; e < header.elements.size(); ++e) {
     const PlyElement &element = header.elements[e];
-    std::uint64_t record = 0;
-    for (const PlyProperty &property : element.properties)
-      record += pcl_ms::io_detail::plyTypeSize(property.value_type);
-    if (element.name == "camera" && element.count > 0) {
-      std::uint64_t property_offset = 0;
-      for (const PlyProperty &property : element.properties) {
-        const int axis = property.name == "viewportx" ? 0 : property.name == "viewporty" ? 1 : -1;
-        if (axis >= 0 && property.value_type == PlyType::Int32) {
-          std::int32_t value = 0;
-          in.clear();
-          if (!in.seekg(static_cast<std::streamoff>(element_begin + (element.count - 1) * record +
-                                                    property_offset)) ||
-              !in.read(reinterpret_cast<char *>(&value), sizeof value))
-            return false;
-          viewport[axis] = static_cast<std::uint32_t>(value);
-        }
-        property_offset += pcl_ms::io_detail::plyTypeSize(property.value_type);
+    if (element.name != "camera" || element.count == 0)
+      continue;
+    const ElementSpan &span = spans[e - 1];
+    std::uint64_t property_offset = 0;
+    for (const PlyProperty &property : element.properties) {
+      const int axis = property.name == "viewportx" ? 0 : property.name == "viewporty" ? 1 : -1;
+      if (axis >= 0 && property.value_type == PlyType::Int32) {
+        std::int32_t value = 0;
+        in.clear();
+        if (!in.seekg(static_cast<std::streamoff>(
+                span.begin + (element.count - 1) * span.record_bytes + property_offset)) ||
+            !in.read(reinterpret_cast<char *>(&value), sizeof value))
+          return false;
+        viewport[axis] = static_cast<std::uint32_t>(value);
       }
+      property_offset += pcl_ms::io_detail::plyTypeSize(property.value_type);
     }
-    element_begin += record * element.count;
   }
   const bool rows = viewport[0] * viewport[1] == points;
   width = static_cast<std::uint32_t>(rows ? viewport[0] : points);
@@ -170,28 +199,18 @@ bool describeBinaryPly(std::istream &in, std::uintmax_t size, BinaryCloudLayout 
   // then rank 0's reader reports it. A file cut within the vertices is
   // reported by the rank whose range is missing, as for a PCD (by rank 0's
   // reader if the cut-off camera holds a viewport to read).
-  std::uint64_t after_vertices = 0;
-  for (std::size_t e = 1; e < header.elements.size(); ++e) {
-    std::uint64_t record = 0;
-    for (const PlyProperty &property : header.elements[e].properties) {
-      if (property.is_list)
-        return false;
-      record += pcl_ms::io_detail::plyTypeSize(property.value_type);
-    }
-    if (record > 0 && header.elements[e].count > size / record)
-      return false;
-    after_vertices += record * header.elements[e].count;
-    if (after_vertices > size)
-      return false;
-  }
   const std::uint64_t vertices_end = header.header_bytes + vertices.count * offset;
-  if (size >= vertices_end && size - vertices_end < after_vertices)
+  std::vector<ElementSpan> spans;
+  std::uint64_t elements_end = 0;
+  if (!spansAfterVertices(header, vertices_end, size, spans, elements_end))
+    return false;
+  if (size >= vertices_end && size < elements_end)
     return false;
   found.data_offset = header.header_bytes;
   found.points = vertices.count;
   found.record_bytes = offset;
   found.file_size = size;
-  if (!readViewport(in, header, vertices_end, found.width, found.height))
+  if (!readViewport(in, header, spans, found.width, found.height))
     return false;
   found.xyz_only = vertices.properties.size() == 3 && offset == 12 && found.xyz[0] == 0 &&
                    found.xyz[1] == 4 && found.xyz[2] == 8;
