@@ -12,12 +12,8 @@
 
 #include <pcl_ms/io.h>
 
-#include <unistd.h>
-
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -33,12 +29,6 @@ int floatFieldOffset(const pcl::PCLPointCloud2 &cloud, const char *name) {
   return -1;
 }
 
-/// The scratch file goes with the input, so that replays leave nothing.
-struct ScratchFile {
-  std::string path;
-  ~ScratchFile() { std::remove(path.c_str()); }
-};
-
 std::uint32_t floatBits(const std::uint8_t *at) {
   std::uint32_t bits;
   std::memcpy(&bits, at, sizeof bits);
@@ -50,14 +40,8 @@ std::uint32_t floatBits(const std::uint8_t *at) {
 /// The target's body (see PCL_MS_FUZZ_TARGET).
 inline int binaryLayoutOneInput(const std::uint8_t *data, std::size_t size) {
   const bool ply = size > 0 && (data[0] & 1);
-  const ScratchFile scratch{"/tmp/pcl_ms_fuzz_layout_" + std::to_string(::getpid()) +
-                            (ply ? ".ply" : ".pcd")};
-  const std::string &path = scratch.path;
-  {
-    std::ofstream file(path, std::ios::binary | std::ios::trunc);
-    if (size > 1)
-      file.write(reinterpret_cast<const char *>(data + 1), static_cast<std::streamsize>(size - 1));
-  }
+  const ScratchFile scratch(ply ? ".ply" : ".pcd", data + (size > 0), size - (size > 0));
+  const std::string &path = scratch.path();
   pcl_ms_mpi::BinaryCloudLayout layout;
   std::string fields;
   if (!pcl_ms_mpi::describeBinaryCloud(path, layout, fields))

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The fuzz targets' reader of the fuzzer's bytes, how a target reports a
-// broken promise (it aborts, which libFuzzer records as a finding), and its
-// entry point.
+// The fuzz targets' reader of the fuzzer's bytes, the bytes as a file for
+// readers that take a path, how a target reports a broken promise (it
+// aborts, which libFuzzer records as a finding), and its entry point.
 #pragma once
 
 #include <algorithm>
@@ -9,7 +9,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <string>
 #include <vector>
+
+#include <unistd.h>
 
 namespace pcl_ms_fuzz {
 
@@ -40,6 +44,25 @@ private:
   const std::uint8_t *data_;
   std::size_t size_;
   std::size_t position_ = 0;
+};
+
+/// The bytes written to a file of this process (fuzzers may run side by
+/// side) with the given extension, removed with the input so that runs and
+/// replays leave nothing behind.
+class ScratchFile {
+public:
+  ScratchFile(const std::string &extension, const std::uint8_t *data, std::size_t size)
+      : path_("/tmp/pcl_ms_fuzz_" + std::to_string(::getpid()) + extension) {
+    std::ofstream file(path_, std::ios::binary | std::ios::trunc);
+    file.write(reinterpret_cast<const char *>(data), static_cast<std::streamsize>(size));
+  }
+  ScratchFile(const ScratchFile &) = delete;
+  ScratchFile &operator=(const ScratchFile &) = delete;
+  ~ScratchFile() { std::remove(path_.c_str()); }
+  const std::string &path() const { return path_; }
+
+private:
+  std::string path_;
 };
 
 [[noreturn]] inline void broken(const char *promise) {

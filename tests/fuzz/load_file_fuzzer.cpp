@@ -8,21 +8,11 @@
 
 #include <pcl_ms/io.h>
 
-#include <unistd.h>
-
 #include <cstdint>
-#include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <string>
 
 namespace {
-
-const std::string &scratchPath() {
-  static const std::string path =
-      "/tmp/pcl_ms_fuzz_" + std::to_string(::getpid()) + PCL_MS_FUZZ_EXTENSION;
-  return path;
-}
 
 using pcl_ms_fuzz::broken;
 
@@ -57,21 +47,18 @@ void checkMesh(const std::vector<Eigen::Vector3d> &vertices,
 } // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size) {
-  {
-    std::ofstream file(scratchPath(), std::ios::binary | std::ios::trunc);
-    file.write(reinterpret_cast<const char *>(data), static_cast<std::streamsize>(size));
-  }
+  const pcl_ms_fuzz::ScratchFile scratch(PCL_MS_FUZZ_EXTENSION, data, size);
   std::string error;
 #if PCL_MS_FUZZ_MESH
   std::vector<Eigen::Vector3d> vertices;
   std::vector<pcl_ms::Triangle> triangles;
-  if (pcl_ms::loadMesh(scratchPath(), vertices, triangles, error))
+  if (pcl_ms::loadMesh(scratch.path(), vertices, triangles, error))
     checkMesh(vertices, triangles);
   else if (error.empty())
     broken("a failed load says why");
 #else
   pcl::PCLPointCloud2 cloud;
-  if (pcl_ms::loadPointCloud(scratchPath(), cloud, error))
+  if (pcl_ms::loadPointCloud(scratch.path(), cloud, error))
     checkCloud(cloud);
   else if (error.empty())
     broken("a failed load says why");
