@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <random>
@@ -387,9 +388,119 @@ TEST_F(IoLoadPointCloud, MissingOrWrongCoordinateFields) {
   writeFile(path("intensity.pcd"), "VERSION 0.7\nFIELDS intensity\nSIZE 4\nTYPE F\nCOUNT 1\n"
                                    "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n1\n2\n");
   EXPECT_TRUE(contains(expectCloudFailure(path("intensity.pcd")), "'x'"));
-  writeFile(path("double.pcd"), "VERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\n"
-                                "WIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3\n");
-  EXPECT_TRUE(contains(expectCloudFailure(path("double.pcd")), "float32"));
+  writeFile(path("short.pcd"), "VERSION 0.7\nFIELDS x y z\nSIZE 2 2 2\nTYPE I I I\nCOUNT 1 1 1\n"
+                               "WIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3\n");
+  const std::string error = expectCloudFailure(path("short.pcd"));
+  EXPECT_TRUE(contains(error, "int16") && contains(error, "float32 or float64")) << error;
+}
+
+/// The bunny's points (and made-up normals) written with double fields:
+/// binary and ASCII PLY as CGAL and Open3D write them, binary and ASCII PCD.
+void writeDoubleClouds(const pcl::PointCloud<pcl::PointXYZ> &points,
+                       const std::function<std::string(const char *)> &path) {
+  std::ostringstream ply_header, pcd_header, ply_ascii, pcd_ascii;
+  ply_header << "element vertex " << points.size() << "\nproperty double x\nproperty double y\n"
+             << "property double z\nproperty double nx\nproperty double ny\nproperty double nz\n"
+             << "end_header\n";
+  pcd_header << "VERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH "
+             << points.size() << "\nHEIGHT 1\nPOINTS " << points.size() << "\nDATA ";
+  std::string ply_binary, pcd_binary;
+  for (const pcl::PointXYZ &point : points) {
+    const double values[6] = {point.x, point.y, point.z, 0.0, 0.6, 0.8};
+    ply_binary.append(reinterpret_cast<const char *>(values), sizeof values);
+    pcd_binary.append(reinterpret_cast<const char *>(values), 3 * sizeof(double));
+    ply_ascii.precision(17);
+    pcd_ascii.precision(17);
+    ply_ascii << values[0] << " " << values[1] << " " << values[2] << " 0 0.6 0.8\n";
+    pcd_ascii << values[0] << " " << values[1] << " " << values[2] << "\n";
+  }
+  writeFile(path("binary.ply"),
+            "ply\nformat binary_little_endian 1.0\n" + ply_header.str() + ply_binary);
+  writeFile(path("ascii.ply"), "ply\nformat ascii 1.0\n" + ply_header.str() + ply_ascii.str());
+  writeFile(path("binary.pcd"), pcd_header.str() + "binary\n" + pcd_binary);
+  writeFile(path("ascii.pcd"), pcd_header.str() + "ascii\n" + pcd_ascii.str());
+}
+
+TEST_F(IoLoadPointCloud, DoubleFieldsAreReadAsFloat) {
+  // Doubles that hold floats exactly: the same points, bit for bit, in
+  // float32 fields; PLY normals too.
+  const auto bunny = pcl_ms_test::loadXYZ("bunny.pcd");
+  writeDoubleClouds(*bunny, [&](const char *name) { return path(name); });
+  for (const char *name : {"binary.ply", "ascii.ply", "binary.pcd", "ascii.pcd"}) {
+    SCOPED_TRACE(name);
+    pcl::PCLPointCloud2 loaded;
+    std::string error;
+    ASSERT_TRUE(pcl_ms::loadPointCloud(path(name), loaded, error)) << error;
+    pcl::PointCloud<pcl::PointNormal> points;
+    pcl::fromPCLPointCloud2(loaded, points);
+    ASSERT_EQ(points.size(), bunny->size());
+    for (std::size_t i = 0; i < points.size(); ++i)
+      ASSERT_TRUE(points[i].getVector3fMap() == (*bunny)[i].getVector3fMap()) << "point " << i;
+    const bool ply = contains(name, ".ply");
+    EXPECT_EQ(pcl_ms::hasNormals(loaded), ply);
+    if (ply) {
+      EXPECT_EQ(points[7].getNormalVector3fMap(), Eigen::Vector3f(0.0f, 0.6f, 0.8f));
+    }
+  }
+}
+
+TEST_F(IoLoadPointCloud, GeoreferencedDoublesAreRefusedNotRounded) {
+  // A terrain patch at UTM coordinates, 0.5 m apart: a float holds a
+  // northing of 5.4e6 to 0.5 m, so rounding would move points by up to a
+  // quarter of a metre. Every reader that rounds doubles refuses it and says
+  // why; the same patch near the origin loads, every point kept.
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> jitter(-0.2, 0.2);
+  std::ostringstream utm_xyz, utm_off, local_xyz;
+  std::string utm_ply;
+  const int side = 40;
+  utm_off << "OFF\n" << side * side << " 0 0\n";
+  for (int i = 0; i < side; ++i)
+    for (int j = 0; j < side; ++j) {
+      const double x = 0.5 * i + jitter(random), y = 0.5 * j + jitter(random);
+      const double z = std::sin(0.2 * i) + 0.1 * jitter(random);
+      const double utm[3] = {512000.0 + x, 5401000.0 + y, 120.0 + z};
+      utm_ply.append(reinterpret_cast<const char *>(utm), sizeof utm);
+      for (std::ostringstream *out : {&utm_xyz, &utm_off, &local_xyz})
+        out->precision(12);
+      utm_xyz << utm[0] << " " << utm[1] << " " << utm[2] << "\n";
+      utm_off << utm[0] << " " << utm[1] << " " << utm[2] << "\n";
+      local_xyz << x << " " << y << " " << z << "\n";
+    }
+  writeFile(path("utm.xyz"), utm_xyz.str());
+  writeFile(path("utm.off"), utm_off.str());
+  writeFile(path("utm.ply"), "ply\nformat binary_little_endian 1.0\nelement vertex " +
+                                 std::to_string(side * side) +
+                                 "\nproperty double x\nproperty double y\nproperty double z\n"
+                                 "end_header\n" +
+                                 utm_ply);
+  for (const char *name : {"utm.xyz", "utm.off", "utm.ply"}) {
+    const std::string error = expectCloudFailure(path(name));
+    EXPECT_TRUE(contains(error, "as large as 5.401e+06") && contains(error, "typical spacing") &&
+                contains(error, "shift the cloud near the origin"))
+        << error;
+  }
+  writeFile(path("local.xyz"), local_xyz.str());
+  pcl::PCLPointCloud2 loaded;
+  std::string error;
+  ASSERT_TRUE(pcl_ms::loadPointCloud(path("local.xyz"), loaded, error)) << error;
+  pcl::PointCloud<pcl::PointXYZ> points;
+  pcl::fromPCLPointCloud2(loaded, points);
+  std::vector<std::array<float, 3>> distinct;
+  for (const pcl::PointXYZ &point : points)
+    distinct.push_back({point.x, point.y, point.z});
+  std::sort(distinct.begin(), distinct.end());
+  EXPECT_EQ(std::unique(distinct.begin(), distinct.end()) - distinct.begin(), side * side);
+}
+
+TEST_F(IoLoadPointCloud, DoubleOutOfFloatRangeIsNamed) {
+  const double values[6] = {1.0, 2.0, 3.0, 4.0, 1e39, 6.0};
+  writeFile(path("huge.ply"),
+            "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty double x\n"
+            "property double y\nproperty double z\nend_header\n" +
+                std::string(reinterpret_cast<const char *>(values), sizeof values));
+  const std::string error = expectCloudFailure(path("huge.ply"));
+  EXPECT_TRUE(contains(error, "point 1: y") && contains(error, "out of float range")) << error;
 }
 
 TEST_F(IoLoadPointCloud, HeaderWithoutPointsFails) {

@@ -29,6 +29,7 @@
 #include <string_view>
 #include <system_error>
 
+#include "float_coordinates.h"
 #include "io_parsing.h"
 #include "mesh_readers.h"
 
@@ -48,6 +49,11 @@ const pcl::PCLPointField *findField(const pcl::PCLPointCloud2 &cloud, const std:
     if (field.name == name)
       return &field;
   return nullptr;
+}
+
+/// Whether a finite value is too large for the float the clouds store.
+bool outOfFloatRange(double value) {
+  return std::isfinite(value) && std::abs(value) > std::numeric_limits<float>::max();
 }
 
 bool isSingleFloatField(const pcl::PCLPointField *field) {
@@ -77,6 +83,69 @@ const char *datatypeName(std::uint8_t datatype) {
   }
 }
 
+/// PCL's point types hold float coordinates and normals, so float64 fields
+/// of those names (CGAL and Open3D write PLY so) are narrowed in place: each
+/// value goes to the first four of its eight bytes, and the record layout
+/// stays as it is. False, with the reason, when a value is out of float
+/// range or the rounding would harm the cloud (CoordinateRounding).
+bool narrowDoubleFields(pcl::PCLPointCloud2 &cloud, std::string &error) {
+  const std::size_t points = static_cast<std::size_t>(cloud.width) * cloud.height;
+  if (cloud.data.size() != points * cloud.point_step)
+    return true; // checkCloudLayout reports it
+  const auto doubleField = [&](const char *name) -> pcl::PCLPointField * {
+    for (pcl::PCLPointField &field : cloud.fields)
+      if (field.name == name)
+        return field.datatype == pcl::PCLPointField::FLOAT64 && field.count <= 1 &&
+                       field.offset + sizeof(double) <= cloud.point_step
+                   ? &field
+                   : nullptr;
+    return nullptr;
+  };
+  const auto narrow = [&](pcl::PCLPointField &field, const auto &round) {
+    for (std::size_t p = 0; p < points; ++p) {
+      std::uint8_t *at = &cloud.data[p * cloud.point_step + field.offset];
+      double value;
+      std::memcpy(&value, at, sizeof value);
+      if (outOfFloatRange(value)) {
+        error = "point " + std::to_string(p) + ": " + field.name + " = " + std::to_string(value) +
+                " is out of float range";
+        return false;
+      }
+      const float narrowed = round(value);
+      std::memcpy(at, &narrowed, sizeof narrowed);
+    }
+    field.datatype = pcl::PCLPointField::FLOAT32;
+    field.count = 1;
+    return true;
+  };
+  CoordinateRounding rounding;
+  bool rounded = false;
+  static const char *const axes[3] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k)
+    if (pcl::PCLPointField *field = doubleField(axes[k])) {
+      if (!narrow(*field, [&](double value) { return rounding.round(value, k); }))
+        return false;
+      rounded = true;
+    }
+  for (const char *name : {"normal_x", "normal_y", "normal_z"})
+    if (pcl::PCLPointField *field = doubleField(name))
+      if (!narrow(*field, [](double value) { return static_cast<float>(value); }))
+        return false;
+  const pcl::PCLPointField *x = findField(cloud, "x"), *y = findField(cloud, "y"),
+                           *z = findField(cloud, "z");
+  if (!rounded || !isSingleFloatField(x) || !isSingleFloatField(y) || !isSingleFloatField(z))
+    return true; // nothing rounded, or checkCloudLayout refuses the fields
+  const auto stored = [&](std::size_t p) {
+    Eigen::Vector3f position;
+    const std::uint8_t *record = &cloud.data[p * cloud.point_step];
+    std::memcpy(&position[0], record + x->offset, sizeof(float));
+    std::memcpy(&position[1], record + y->offset, sizeof(float));
+    std::memcpy(&position[2], record + z->offset, sizeof(float));
+    return position;
+  };
+  return rounding.harmless(points, stored, error);
+}
+
 bool checkCloudLayout(const pcl::PCLPointCloud2 &cloud, std::string &error) {
   for (const char *name : {"x", "y", "z"}) {
     const pcl::PCLPointField *field = findField(cloud, name);
@@ -86,7 +155,7 @@ bool checkCloudLayout(const pcl::PCLPointCloud2 &cloud, std::string &error) {
     }
     if (!isSingleFloatField(field)) {
       error = std::string("field '") + name + "' is " + datatypeName(field->datatype) + " (count " +
-              std::to_string(field->count) + "); float32 coordinates are required";
+              std::to_string(field->count) + "); float32 or float64 coordinates are required";
       return false;
     }
     if (field->offset + sizeof(float) > cloud.point_step) {
@@ -254,11 +323,6 @@ bool loadPlyCloud(const std::string &path, std::uintmax_t size, pcl::PCLPointClo
   return true;
 }
 
-/// Whether a finite value is too large for the float the clouds store.
-bool outOfFloatRange(double value) {
-  return std::isfinite(value) && std::abs(value) > std::numeric_limits<float>::max();
-}
-
 /// A cloud of FLOAT32 columns (x y z [normal_x normal_y normal_z]) from
 /// `values`, `columns` per point.
 void makeFloatCloud(const std::vector<float> &values, std::size_t columns,
@@ -290,6 +354,7 @@ bool loadXyzCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::stri
 
   std::vector<float> values;
   std::size_t columns = 0;
+  CoordinateRounding rounding;
   WordLines lines(bytes);
   while (lines.next()) {
     const std::vector<std::string_view> &words = lines.words();
@@ -317,13 +382,19 @@ bool loadXyzCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::stri
         error = where + printable(word) + " is out of float range";
         return false;
       }
-      values.push_back(static_cast<float>(value));
+      const std::size_t column = values.size() % columns;
+      values.push_back(column < 3 ? rounding.round(value, static_cast<int>(column))
+                                  : static_cast<float>(value));
     }
   }
   if (values.empty()) {
     error = "the file contains no points";
     return false;
   }
+  if (!rounding.harmless(
+          values.size() / columns,
+          [&](std::size_t i) { return Eigen::Vector3f(&values[i * columns]); }, error))
+    return false;
   makeFloatCloud(values, columns, cloud);
   return true;
 }
@@ -396,6 +467,7 @@ bool loadMeshVerticesCloud(const std::string &path, pcl::PCLPointCloud2 &cloud,
   }
   std::vector<float> values;
   values.reserve(3 * vertices.size());
+  CoordinateRounding rounding;
   for (std::size_t i = 0; i < vertices.size(); ++i)
     for (int k = 0; k < 3; ++k) {
       const double value = vertices[i][k];
@@ -403,8 +475,11 @@ bool loadMeshVerticesCloud(const std::string &path, pcl::PCLPointCloud2 &cloud,
         reason = "vertex " + std::to_string(i) + " is out of float range";
         return false;
       }
-      values.push_back(static_cast<float>(value));
+      values.push_back(rounding.round(value, k));
     }
+  if (!rounding.harmless(
+          vertices.size(), [&](std::size_t i) { return Eigen::Vector3f(&values[3 * i]); }, reason))
+    return false;
   makeFloatCloud(values, 3, cloud);
   return true;
 }
@@ -435,7 +510,7 @@ bool loadPointCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::st
       reason =
           unknownFormat(extension, "point cloud",
                         ".pcd, .ply, .xyz, .txt, or a mesh's vertices: .obj, .off, .vtk, .stl");
-    ok = ok && checkCloudLayout(cloud, reason);
+    ok = ok && narrowDoubleFields(cloud, reason) && checkCloudLayout(cloud, reason);
   } catch (const std::exception &exception) {
     reason = std::string("unexpected failure: ") + exception.what();
     ok = false;

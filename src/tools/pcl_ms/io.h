@@ -29,7 +29,11 @@ namespace pcl_ms {
 ///  - .stl (ascii or binary): the mesh's vertices, each position once (STL
 ///    repeats a corner in every facet), in order of first use.
 /// On success `cloud` has FLOAT32 fields x, y, z (plus whatever else the file
-/// holds) and at least one point. On failure `cloud` is left empty.
+/// holds) and at least one point: coordinates read as double (text, mesh
+/// files, FLOAT64 PCD or PLY fields, narrowed in place with FLOAT64 normals)
+/// are rounded, and the file is refused when that moves points by over 1 %
+/// of their typical spacing (float_coordinates.h). On failure `cloud` is
+/// left empty.
 /// `sensor_origin`, when given, receives a PCD file's VIEWPOINT position
 /// (zero for the other formats and on failure).
 bool loadPointCloud(const std::string &path, pcl::PCLPointCloud2 &cloud, std::string &error,
