@@ -44,8 +44,12 @@ bool describeBinaryPcd(std::istream &in, std::uintmax_t size, BinaryCloudLayout 
     if (!isSingleFloat(axis))
       return false;
     found.xyz[k] = static_cast<std::uint32_t>(axis->offset);
+    // Normals of another type are left to rank 0's reader, which narrows
+    // double ones to float.
     const PcdField *normal = header.find(normals[k]);
-    if (isSingleFloat(normal))
+    if (normal && !isSingleFloat(normal))
+      return false;
+    if (normal)
       found.normal[k] = static_cast<std::int32_t>(normal->offset);
   }
   // More records than the file could hold: rank 0's guarded loader reports
@@ -179,8 +183,9 @@ bool describeBinaryPly(std::istream &in, std::uintmax_t size, BinaryCloudLayout 
         found.xyz[k] = static_cast<std::uint32_t>(offset);
         ++axis_count[k];
       } else if (name == normals[k]) {
-        if (property.value_type == PlyType::Float32)
-          found.normal[k] = static_cast<std::int32_t>(offset);
+        if (property.value_type != PlyType::Float32)
+          return false; // as for a PCD
+        found.normal[k] = static_cast<std::int32_t>(offset);
         ++normal_count[k];
       }
     }

@@ -5,8 +5,9 @@
 // z (and the normals) inside each record; three ranks' byte ranges must
 // each be read whole or refused with a reason; and a file read whole in
 // parts must be one the ordinary reader (pcl_ms::loadPointCloud) accepts,
-// with the same points and normals, bit for bit, and the same width and
-// height: ranks and one process mesh the same cloud from the same viewpoint.
+// with the same points and normals (none where it has none), bit for bit,
+// and the same width and height: ranks and one process mesh the same cloud
+// from the same viewpoint.
 #include "fuzz_bytes.h"
 #include "mpi_cloud_reader.h"
 
@@ -85,6 +86,8 @@ inline int binaryLayoutOneInput(const std::uint8_t *data, std::size_t size) {
     broken("the ordinary reader finds as many points");
   if (cloud.width != layout.width || cloud.height != layout.height)
     broken("the ordinary reader sees the same rows (an organized cloud has a viewpoint)");
+  if (pcl_ms::hasNormals(cloud) != layout.hasNormals())
+    broken("normals are read in parts exactly when the ordinary reader has them");
   const int axes[3] = {floatFieldOffset(cloud, "x"), floatFieldOffset(cloud, "y"),
                        floatFieldOffset(cloud, "z")};
   const int normals[3] = {floatFieldOffset(cloud, "normal_x"), floatFieldOffset(cloud, "normal_y"),
