@@ -6,6 +6,7 @@
 #include <pcl_ms/medial_scaffold_reconstruction.h>
 
 #include <algorithm>
+#include <random>
 #include <set>
 
 namespace {
@@ -94,6 +95,38 @@ TEST(Buckets, GridSeamsMatchTheOnePieceMesh) {
   pcl_ms::Parameters parameters;
   parameters.grid_buckets = 3; // 27 cells of the bounding box, some empty
   expectSeamsInvisible("bunny.pcd", parameters, 8);
+}
+
+TEST(Buckets, FineGridOverFewPointsClosesTheSurface) {
+  // 16 points of a lumpy ball in the finest grid: no cell holds two, so no
+  // bucket has a spacing of its own. The cloud's spacing gives them margins
+  // that reach their neighbours, and the seams close the surface as the
+  // one-piece run does (it used to fail: "no bucket could be meshed"), up
+  // to the diagonal of a quad.
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  std::mt19937 random(11);
+  std::normal_distribution<float> direction;
+  std::uniform_real_distribution<float> radius(0.9f, 1.1f);
+  while (cloud.size() < 16) {
+    Eigen::Vector3f p(direction(random), direction(random), direction(random));
+    p = radius(random) * p.normalized();
+    cloud.push_back(pcl::PointXYZ(p.x(), 0.8f * p.y(), 0.6f * p.z()));
+  }
+  const pcl_ms::Result whole = pcl_ms::reconstruct(viewOf(cloud), pcl_ms::Parameters());
+  pcl_ms::Parameters gridded;
+  gridded.grid_buckets = pcl_ms::max_grid_buckets;
+  const pcl_ms::Result pieces = pcl_ms::reconstruct(viewOf(cloud), gridded);
+  ASSERT_EQ(pieces.bucket_statistics.buckets, cloud.size()); // one point each
+  EXPECT_EQ(pieces.bucket_statistics.failed_units, 0u);
+  for (const pcl_ms::Result *result : {&whole, &pieces}) {
+    const pcl_ms::MeshTopologyReport report =
+        pcl_ms::analyzeMesh(positions(cloud), result->triangles);
+    expectCleanManifold(report);
+    EXPECT_EQ(report.components, 1u);
+    EXPECT_EQ(report.boundary_loops, 0u);
+    EXPECT_EQ(result->triangles.size(), 2 * cloud.size() - 4); // closed, every point used
+  }
+  EXPECT_GE(commonTriangles(pieces.triangles, whole.triangles), whole.triangles.size() - 2);
 }
 
 TEST(Buckets, SameMeshForOneTwoAndEightThreads) {

@@ -248,31 +248,45 @@ private:
   Eigen::Vector3d grid_low_ = Eigen::Vector3d::Zero(), grid_cell_ = Eigen::Vector3d::Ones();
 };
 
-/// For each bucket, the median nearest-neighbour distance from a few of its
-/// points to the others (a bucket is big enough for this); 0 for a bucket
-/// of fewer than 2 points. Buckets differ: a cloud's density varies.
+/// The median nearest-neighbour distance from a few of `members` to the
+/// others; 0 for fewer than 2 members.
+double medianSpacing(const std::vector<Eigen::Vector3d> &points,
+                     const std::vector<VertexIndex> &members) {
+  std::vector<double> distances;
+  const std::size_t samples =
+      members.size() < 2 ? 0 : std::min(spacing_samples_per_bucket, members.size());
+  for (std::size_t s = 0; s < samples; ++s) {
+    const VertexIndex query = members[s * members.size() / samples];
+    double nearest = std::numeric_limits<double>::infinity();
+    for (VertexIndex other : members)
+      if (other != query)
+        nearest = std::min(nearest, (points[other] - points[query]).squaredNorm());
+    distances.push_back(std::sqrt(nearest));
+  }
+  if (distances.empty())
+    return 0;
+  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+  return distances[distances.size() / 2];
+}
+
+/// For each bucket, its median spacing (a bucket is big enough for this):
+/// buckets differ, as a cloud's density varies. A bucket of fewer than 2
+/// points takes the largest; when no bucket has 2 (a small cloud in a fine
+/// grid), all take the whole cloud's, so that their margins reach their
+/// neighbours and the seams can join them.
 std::vector<double> bucketSpacings(const std::vector<Eigen::Vector3d> &points, BucketTree &tree) {
   std::vector<double> spacings;
-  for (int leaf : tree.leaves()) {
-    const std::vector<VertexIndex> &members = tree.nodes()[leaf].points;
-    std::vector<double> distances;
-    const std::size_t samples =
-        members.size() < 2 ? 0 : std::min(spacing_samples_per_bucket, members.size());
-    for (std::size_t s = 0; s < samples; ++s) {
-      const VertexIndex query = members[s * members.size() / samples];
-      double nearest = std::numeric_limits<double>::infinity();
-      for (VertexIndex other : members)
-        if (other != query)
-          nearest = std::min(nearest, (points[other] - points[query]).squaredNorm());
-      distances.push_back(std::sqrt(nearest));
-    }
-    if (distances.empty()) {
-      spacings.push_back(0);
-      continue;
-    }
-    std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
-    spacings.push_back(distances[distances.size() / 2]);
+  for (int leaf : tree.leaves())
+    spacings.push_back(medianSpacing(points, tree.nodes()[leaf].points));
+  double fallback = *std::max_element(spacings.begin(), spacings.end());
+  if (!(fallback > 0)) {
+    std::vector<VertexIndex> all(points.size());
+    std::iota(all.begin(), all.end(), 0);
+    fallback = medianSpacing(points, all);
   }
+  for (double &spacing : spacings)
+    if (!(spacing > 0))
+      spacing = fallback;
   return spacings;
 }
 
@@ -331,11 +345,10 @@ public:
     // Each bucket's margin follows its own spacing: a triangle is up to rho
     // local scales long, and a sparse bucket's scale is larger.
     const std::vector<double> spacings = bucketSpacings(points_, tree_);
-    const double largest_spacing = *std::max_element(spacings.begin(), spacings.end());
     leaf_margin_.resize(spacings.size());
     for (std::size_t leaf = 0; leaf < spacings.size(); ++leaf)
-      leaf_margin_[leaf] = (parameters_.rho + margin_context_in_d_med) * d_med_per_spacing *
-                           (spacings[leaf] > 0 ? spacings[leaf] : largest_spacing);
+      leaf_margin_[leaf] =
+          (parameters_.rho + margin_context_in_d_med) * d_med_per_spacing * spacings[leaf];
 
     tbb::task_arena arena = detail::threadArena(parameters_.num_threads);
     Clock::time_point stage = Clock::now();
