@@ -110,6 +110,19 @@ void expectSameCloud(const pcl::PointCloud<pcl::PointNormal> &expected,
   }
 }
 
+/// Loads `file`, whose points must be `expected`'s, bit for bit, into `loaded`.
+void expectSamePoints(const std::string &file, const pcl::PointCloud<pcl::PointXYZ> &expected,
+                      pcl::PCLPointCloud2 &loaded) {
+  SCOPED_TRACE(file);
+  std::string error;
+  ASSERT_TRUE(pcl_ms::loadPointCloud(file, loaded, error)) << error;
+  pcl::PointCloud<pcl::PointXYZ> points;
+  pcl::fromPCLPointCloud2(loaded, points);
+  ASSERT_EQ(points.size(), expected.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    ASSERT_TRUE(points[i].getVector3fMap() == expected[i].getVector3fMap()) << "point " << i;
+}
+
 // ---------------------------------------------------------------------------
 // Point clouds
 
@@ -427,19 +440,14 @@ TEST_F(IoLoadPointCloud, DoubleFieldsAreReadAsFloat) {
   const auto bunny = pcl_ms_test::loadXYZ("bunny.pcd");
   writeDoubleClouds(*bunny, [&](const char *name) { return path(name); });
   for (const char *name : {"binary.ply", "ascii.ply", "binary.pcd", "ascii.pcd"}) {
-    SCOPED_TRACE(name);
     pcl::PCLPointCloud2 loaded;
-    std::string error;
-    ASSERT_TRUE(pcl_ms::loadPointCloud(path(name), loaded, error)) << error;
-    pcl::PointCloud<pcl::PointNormal> points;
-    pcl::fromPCLPointCloud2(loaded, points);
-    ASSERT_EQ(points.size(), bunny->size());
-    for (std::size_t i = 0; i < points.size(); ++i)
-      ASSERT_TRUE(points[i].getVector3fMap() == (*bunny)[i].getVector3fMap()) << "point " << i;
+    ASSERT_NO_FATAL_FAILURE(expectSamePoints(path(name), *bunny, loaded));
     const bool ply = contains(name, ".ply");
-    EXPECT_EQ(pcl_ms::hasNormals(loaded), ply);
+    EXPECT_EQ(pcl_ms::hasNormals(loaded), ply) << name;
     if (ply) {
-      EXPECT_EQ(points[7].getNormalVector3fMap(), Eigen::Vector3f(0.0f, 0.6f, 0.8f));
+      pcl::PointCloud<pcl::PointNormal> points;
+      pcl::fromPCLPointCloud2(loaded, points);
+      EXPECT_EQ(points[7].getNormalVector3fMap(), Eigen::Vector3f(0.0f, 0.6f, 0.8f)) << name;
     }
   }
 }
@@ -549,15 +557,8 @@ TEST_F(IoLoadPointCloud, MeshVerticesInFileOrderWithOrWithoutFaces) {
   writeFile(path("bunny.vtk"), vtk.str());
   const auto expected = pcl_ms_test::loadXYZ("bunny.pcd");
   for (const char *name : {"bunny.obj", "bunny.off", "bunny.vtk"}) {
-    SCOPED_TRACE(name);
     pcl::PCLPointCloud2 loaded;
-    std::string error;
-    ASSERT_TRUE(pcl_ms::loadPointCloud(path(name), loaded, error)) << error;
-    pcl::PointCloud<pcl::PointXYZ> points;
-    pcl::fromPCLPointCloud2(loaded, points);
-    ASSERT_EQ(points.size(), expected->size());
-    for (std::size_t i = 0; i < points.size(); ++i)
-      ASSERT_TRUE(points[i].getVector3fMap() == (*expected)[i].getVector3fMap()) << "point " << i;
+    ASSERT_NO_FATAL_FAILURE(expectSamePoints(path(name), *expected, loaded));
   }
   writeFile(path("empty.off"), "OFF\n0 0 0\n");
   EXPECT_TRUE(contains(expectCloudFailure(path("empty.off")), "no vertices"));
