@@ -107,8 +107,10 @@ bool narrowDoubleFields(pcl::PCLPointCloud2 &cloud, std::string &error) {
       double value;
       std::memcpy(&value, at, sizeof value);
       if (outOfFloatRange(value)) {
-        error = "point " + std::to_string(p) + ": " + field.name + " = " + std::to_string(value) +
-                " is out of float range";
+        std::ostringstream message;
+        message << "point " << p << ": " << field.name << " = " << value
+                << " is out of float range";
+        error = message.str();
         return false;
       }
       const float narrowed = round(value);
