@@ -22,7 +22,7 @@ set_property(CACHE PCL_MS_BUILD_ROS PROPERTY STRINGS AUTO ON OFF)
 
 add_library(pcl_ms_ros_bridge STATIC "${PROJECT_SOURCE_DIR}/src/ros/cloud_meshing.cpp")
 target_include_directories(pcl_ms_ros_bridge PUBLIC "${PROJECT_SOURCE_DIR}/src/ros")
-target_link_libraries(pcl_ms_ros_bridge PUBLIC pcl_ms)
+target_link_libraries(pcl_ms_ros_bridge PUBLIC pcl_ms PRIVATE pcl_ms_metrics)
 pcl_ms_set_warnings(pcl_ms_ros_bridge)
 
 if(PCL_MS_BUILD_TESTS)

@@ -3,6 +3,8 @@
 
 #include <pcl_ms/medial_scaffold_reconstruction.h>
 
+#include "float_coordinates.h"
+
 #include <pcl/PCLPointField.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -52,8 +54,11 @@ std::size_t datatypeSize(std::uint8_t datatype) {
   }
 }
 
+// Coordinates and normals come as FLOAT32, or as FLOAT64 read as float (the
+// point types hold float), as the file readers do.
 bool isFloatField(const pcl::PCLPointField *field) {
-  return field && field->datatype == pcl::PCLPointField::FLOAT32;
+  return field && (field->datatype == pcl::PCLPointField::FLOAT32 ||
+                   field->datatype == pcl::PCLPointField::FLOAT64);
 }
 
 // Byte offset of point `index` in row-major order, honouring row padding.
@@ -63,24 +68,40 @@ std::size_t pointOffset(const pcl::PCLPointCloud2 &cloud, std::size_t index) {
   return row * cloud.row_step + column * cloud.point_step;
 }
 
-float readFloat(const pcl::PCLPointCloud2 &cloud, std::size_t offset) {
+// Where a FLOAT32 or FLOAT64 field lies in a point.
+struct FloatField {
+  std::uint32_t offset = 0;
+  bool is_double = false;
+};
+
+double readValue(const pcl::PCLPointCloud2 &cloud, std::size_t point_base, FloatField field) {
+  const std::uint8_t *at = &cloud.data[point_base + field.offset];
+  if (field.is_double) {
+    double value;
+    std::memcpy(&value, at, sizeof value);
+    return value;
+  }
   float value;
-  std::memcpy(&value, &cloud.data[offset], sizeof value);
+  std::memcpy(&value, at, sizeof value);
   return value;
 }
 
-// Byte offsets within a point of three fields the cloud is known to have.
-std::array<std::uint32_t, 3> fieldOffsets(const pcl::PCLPointCloud2 &cloud,
-                                          const std::array<const char *, 3> &names) {
-  return {findField(cloud.fields, names[0])->offset, findField(cloud.fields, names[1])->offset,
-          findField(cloud.fields, names[2])->offset};
+// Three float fields the cloud is known to have.
+std::array<FloatField, 3> floatFields(const pcl::PCLPointCloud2 &cloud,
+                                      const std::array<const char *, 3> &names) {
+  std::array<FloatField, 3> fields;
+  for (int k = 0; k < 3; ++k) {
+    const pcl::PCLPointField *field = findField(cloud.fields, names[k]);
+    fields[k] = {field->offset, field->datatype == pcl::PCLPointField::FLOAT64};
+  }
+  return fields;
 }
 
 // Reads positions from a cloud whose layout checkCloudLayout accepted.
 class PositionReader {
 public:
   explicit PositionReader(const pcl::PCLPointCloud2 &cloud)
-      : cloud_(cloud), offsets_(fieldOffsets(cloud, {"x", "y", "z"})),
+      : cloud_(cloud), fields_(floatFields(cloud, {"x", "y", "z"})),
         point_count_(static_cast<std::size_t>(cloud.width) * cloud.height) {}
 
   // False when `index` lies outside the cloud or the point is not finite.
@@ -89,7 +110,7 @@ public:
       return false;
     const std::size_t base = pointOffset(cloud_, static_cast<std::size_t>(index));
     for (int axis = 0; axis < 3; ++axis) {
-      position[axis] = readFloat(cloud_, base + offsets_[axis]);
+      position[axis] = static_cast<float>(readValue(cloud_, base, fields_[axis]));
       if (!std::isfinite(position[axis]))
         return false;
     }
@@ -98,7 +119,7 @@ public:
 
 private:
   const pcl::PCLPointCloud2 &cloud_;
-  std::array<std::uint32_t, 3> offsets_;
+  std::array<FloatField, 3> fields_;
   std::size_t point_count_;
 };
 
@@ -132,33 +153,36 @@ std::array<float, 4> readColor(const pcl::PCLPointCloud2 &cloud, std::uint32_t f
 }
 
 // The typed cloud of a cloud whose layout checkCloudLayout accepted (and, for
-// PointNormal, with FLOAT32 normals): only what meshing reads. Unlike
+// PointNormal, with float normals): only what meshing reads. Unlike
 // pcl::fromPCLPointCloud2 it does not warn, on every message, about the
 // fields the point type has and the message lacks (a PointNormal's
-// curvature).
+// curvature), and it reads FLOAT64 fields. False, with the reason, when
+// rounding double coordinates to float would harm the cloud.
 template <typename PointT>
-void copyPoints(const pcl::PCLPointCloud2 &cloud, pcl::PointCloud<PointT> &points) {
+bool copyPoints(const pcl::PCLPointCloud2 &cloud, pcl::PointCloud<PointT> &points,
+                std::string &error) {
   points.header = cloud.header;
   points.width = cloud.width;
   points.height = cloud.height;
   points.is_dense = cloud.is_dense;
   points.resize(static_cast<std::size_t>(cloud.width) * cloud.height);
-  const std::array<std::uint32_t, 3> xyz = fieldOffsets(cloud, {"x", "y", "z"});
-  std::array<std::uint32_t, 3> normal{};
+  const std::array<FloatField, 3> xyz = floatFields(cloud, {"x", "y", "z"});
+  std::array<FloatField, 3> normal{};
   if constexpr (pcl::traits::has_normal_v<PointT>)
-    normal = fieldOffsets(cloud, {"normal_x", "normal_y", "normal_z"});
+    normal = floatFields(cloud, {"normal_x", "normal_y", "normal_z"});
+  io_detail::CoordinateRounding rounding;
   for (std::size_t i = 0; i < points.size(); ++i) {
     const std::size_t base = pointOffset(cloud, i);
     PointT &point = points[i];
-    point.x = readFloat(cloud, base + xyz[0]);
-    point.y = readFloat(cloud, base + xyz[1]);
-    point.z = readFloat(cloud, base + xyz[2]);
-    if constexpr (pcl::traits::has_normal_v<PointT>) {
-      point.normal_x = readFloat(cloud, base + normal[0]);
-      point.normal_y = readFloat(cloud, base + normal[1]);
-      point.normal_z = readFloat(cloud, base + normal[2]);
-    }
+    for (int k = 0; k < 3; ++k)
+      point.data[k] = rounding.round(readValue(cloud, base, xyz[k]), k);
+    if constexpr (pcl::traits::has_normal_v<PointT>)
+      for (int k = 0; k < 3; ++k)
+        point.data_n[k] = static_cast<float>(readValue(cloud, base, normal[k]));
   }
+  return rounding.harmless(
+      points.size(), [&](std::size_t i) { return Eigen::Vector3f(points[i].getVector3fMap()); },
+      error);
 }
 
 template <typename PointT>
@@ -166,8 +190,10 @@ void meshTypedCloud(const pcl::PCLPointCloud2 &cloud, const pcl_ms::Parameters &
                     bool use_normals, MeshingOutcome &outcome) {
   const Clock::time_point conversion_start = Clock::now();
   typename pcl::PointCloud<PointT>::Ptr points(new pcl::PointCloud<PointT>);
-  copyPoints(cloud, *points);
+  const bool usable = copyPoints(cloud, *points, outcome.error);
   outcome.conversion_seconds = secondsSince(conversion_start);
+  if (!usable)
+    return;
 
   pcl::MedialScaffoldReconstruction<PointT> reconstruction;
   reconstruction.setParameters(parameters);
@@ -222,8 +248,8 @@ std::string checkCloudLayout(const pcl::PCLPointCloud2 &cloud) {
       reason << "the cloud has no '" << name << "' field";
       return reason.str();
     }
-    if (field->datatype != pcl::PCLPointField::FLOAT32) {
-      reason << "field '" << name << "' is not FLOAT32 (datatype "
+    if (!isFloatField(field)) {
+      reason << "field '" << name << "' is not FLOAT32 or FLOAT64 (datatype "
              << static_cast<int>(field->datatype) << ")";
       return reason.str();
     }
@@ -259,7 +285,7 @@ MeshingOutcome meshCloud(const pcl::PCLPointCloud2 &cloud, const pcl_ms::Paramet
   if (!outcome.error.empty())
     return outcome;
   if (parameters.use_normals && !hasNormalFields(cloud.fields))
-    outcome.warning = "use_normals is set but the cloud has no FLOAT32 normal_x/y/z fields: "
+    outcome.warning = "use_normals is set but the cloud has no float normal_x/y/z fields: "
                       "meshed without normals";
   try {
     if (choosePointType(cloud.fields, parameters.use_normals) == MeshingPointType::xyz_normal)

@@ -27,12 +27,14 @@ enum class MeshingPointType { xyz, xyz_normal };
 /// PointXYZ unless normals are wanted and the cloud has normal_x/y/z.
 MeshingPointType choosePointType(const std::vector<pcl::PCLPointField> &fields, bool use_normals);
 
-/// True when the fields include FLOAT32 normal_x, normal_y and normal_z.
+/// True when the fields include normal_x, normal_y and normal_z, each
+/// FLOAT32 or FLOAT64.
 bool hasNormalFields(const std::vector<pcl::PCLPointField> &fields);
 
 /// Empty when the cloud's layout can be read, else a one-line reason: no
-/// points, x/y/z missing or not FLOAT32, a field outside the point, rows or
-/// data shorter than the sizes claim, big-endian data.
+/// points, x/y/z missing or neither FLOAT32 nor FLOAT64 (read as float), a
+/// field outside the point, rows or data shorter than the sizes claim,
+/// big-endian data.
 std::string checkCloudLayout(const pcl::PCLPointCloud2 &cloud);
 
 /// What meshing one cloud gave.

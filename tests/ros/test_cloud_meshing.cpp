@@ -81,6 +81,36 @@ pcl::PCLPointCloud2 makeOrganizedFrame() {
   return makeColoredCloud(width, height, points);
 }
 
+// The same points with x, y, z as FLOAT64 (8 bytes each, then rgb), each
+// coordinate plus `offset`.
+pcl::PCLPointCloud2 withDoubleCoordinates(const pcl::PCLPointCloud2 &cloud,
+                                          const std::array<double, 3> &offset = {0, 0, 0}) {
+  pcl::PCLPointCloud2 wide;
+  wide.width = cloud.width;
+  wide.height = cloud.height;
+  wide.fields = {makeField("x", 0, pcl::PCLPointField::FLOAT64),
+                 makeField("y", 8, pcl::PCLPointField::FLOAT64),
+                 makeField("z", 16, pcl::PCLPointField::FLOAT64),
+                 makeField("rgb", 24, pcl::PCLPointField::UINT32)};
+  wide.point_step = 28;
+  wide.row_step = wide.width * wide.point_step;
+  wide.is_dense = cloud.is_dense;
+  wide.data.assign(static_cast<std::size_t>(wide.row_step) * wide.height, 0);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(cloud.width) * cloud.height; ++i) {
+    const std::uint8_t *from =
+        &cloud.data[(i / cloud.width) * cloud.row_step + (i % cloud.width) * cloud.point_step];
+    std::uint8_t *to = &wide.data[i * wide.point_step];
+    for (int k = 0; k < 3; ++k) {
+      float value;
+      std::memcpy(&value, from + 4 * k, sizeof value);
+      const double widened = static_cast<double>(value) + offset[k];
+      std::memcpy(to + 8 * k, &widened, sizeof widened);
+    }
+    std::memcpy(to + 24, from + 12, 4);
+  }
+  return wide;
+}
+
 std::size_t countFinitePoints(const pcl::PCLPointCloud2 &cloud) {
   std::size_t finite = 0;
   for (std::size_t i = 0; i < static_cast<std::size_t>(cloud.width) * cloud.height; ++i) {
@@ -92,6 +122,14 @@ std::size_t countFinitePoints(const pcl::PCLPointCloud2 &cloud) {
     finite += std::isfinite(z) ? 1 : 0;
   }
   return finite;
+}
+
+// The corner indices of each polygon, in order.
+std::vector<pcl::Indices> cornersOf(const std::vector<pcl::Vertices> &polygons) {
+  std::vector<pcl::Indices> corners;
+  for (const pcl::Vertices &polygon : polygons)
+    corners.push_back(polygon.vertices);
+  return corners;
 }
 
 // Edges used by more than two triangles.
@@ -125,9 +163,9 @@ TEST(RosBridgeLayout, RefusesEachBrokenLayoutWithItsReason) {
   no_z.fields.erase(no_z.fields.begin() + 2);
   EXPECT_NE(checkCloudLayout(no_z).find("no 'z' field"), std::string::npos);
 
-  pcl::PCLPointCloud2 double_x = good;
-  double_x.fields[0].datatype = pcl::PCLPointField::FLOAT64;
-  EXPECT_NE(checkCloudLayout(double_x).find("'x' is not FLOAT32"), std::string::npos);
+  pcl::PCLPointCloud2 integer_x = good;
+  integer_x.fields[0].datatype = pcl::PCLPointField::INT32;
+  EXPECT_NE(checkCloudLayout(integer_x).find("'x' is not FLOAT32 or FLOAT64"), std::string::npos);
 
   pcl::PCLPointCloud2 field_outside = good;
   field_outside.fields[3].offset = 18;
@@ -160,7 +198,9 @@ TEST(RosBridgePointType, NormalsOnlyWhenAskedForAndPresent) {
   EXPECT_EQ(choosePointType(with_normals, false), MeshingPointType::xyz);
   EXPECT_EQ(choosePointType(with_normals, true), MeshingPointType::xyz_normal);
 
-  with_normals[4].datatype = pcl::PCLPointField::FLOAT64;
+  with_normals[4].datatype = pcl::PCLPointField::FLOAT64; // read as float
+  EXPECT_EQ(choosePointType(with_normals, true), MeshingPointType::xyz_normal);
+  with_normals[4].datatype = pcl::PCLPointField::INT16;
   EXPECT_EQ(choosePointType(with_normals, true), MeshingPointType::xyz);
 }
 
@@ -241,6 +281,30 @@ TEST(RosBridgeMeshing, OrganizedFrameFacesItsOriginOrTheGivenViewpoint) {
   ASSERT_EQ(from_behind.error, "");
   EXPECT_GT(countFacing(frame, from_behind.polygons, {0, 0, 5}),
             from_behind.polygons.size() * 95 / 100);
+}
+
+TEST(RosBridgeMeshing, DoubleCoordinatesMeshAsTheirFloats) {
+  // FLOAT64 x, y, z holding the frame's floats: read as float, the same
+  // mesh and markers. Far from the origin (UTM-like), rounding to float
+  // would move the pixels by much of their spacing: refused with the reason.
+  const pcl::PCLPointCloud2 frame = makeOrganizedFrame();
+  const pcl::PCLPointCloud2 wide = withDoubleCoordinates(frame);
+  ASSERT_EQ(checkCloudLayout(wide), "");
+  const MeshingOutcome narrow_outcome = meshCloud(frame, pcl_ms::Parameters());
+  const MeshingOutcome wide_outcome = meshCloud(wide, pcl_ms::Parameters());
+  ASSERT_EQ(wide_outcome.error, "");
+  ASSERT_FALSE(wide_outcome.polygons.empty());
+  EXPECT_EQ(cornersOf(wide_outcome.polygons), cornersOf(narrow_outcome.polygons));
+  EXPECT_EQ(cornersOf(wide_outcome.boundary_loops), cornersOf(narrow_outcome.boundary_loops));
+  const MarkerGeometry narrow_markers = triangleListGeometry(frame, narrow_outcome.polygons);
+  const MarkerGeometry wide_markers = triangleListGeometry(wide, wide_outcome.polygons);
+  EXPECT_EQ(wide_markers.points, narrow_markers.points);
+  EXPECT_EQ(wide_markers.colors, narrow_markers.colors);
+
+  const MeshingOutcome far =
+      meshCloud(withDoubleCoordinates(frame, {512000.0, 5401000.0, 0.0}), pcl_ms::Parameters());
+  EXPECT_NE(far.error.find("shift the cloud near the origin"), std::string::npos) << far.error;
+  EXPECT_TRUE(far.polygons.empty());
 }
 
 TEST(RosBridgeMeshing, BadCloudsComeBackAsErrorsNotCrashes) {
