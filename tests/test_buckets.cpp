@@ -6,6 +6,7 @@
 #include <pcl_ms/medial_scaffold_reconstruction.h>
 
 #include <algorithm>
+#include <array>
 #include <random>
 #include <set>
 
@@ -127,6 +128,31 @@ TEST(Buckets, FineGridOverFewPointsClosesTheSurface) {
     EXPECT_EQ(result->triangles.size(), 2 * cloud.size() - 4); // closed, every point used
   }
   EXPECT_GE(commonTriangles(pieces.triangles, whole.triangles), whole.triangles.size() - 2);
+}
+
+TEST(Buckets, TooManyBucketsForTheCloudIsExplained) {
+  // Two triangles' corners in pairs 0.07 apart, the pairs a unit apart: in a
+  // 3 x 3 x 3 grid each bucket's margin (from its pair's spacing) reaches no
+  // third point, so no bucket can be meshed; the error says what to do.
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  for (const auto &p : std::vector<std::array<float, 3>>{{1.05f, 0.05f, 1},
+                                                         {1.05f, 1.05f, 2},
+                                                         {0.05f, 1.05f, 1},
+                                                         {0, 0, 0},
+                                                         {1, 0, 1},
+                                                         {0, 1, 1}})
+    cloud.push_back(pcl::PointXYZ(p[0], p[1], p[2]));
+  EXPECT_FALSE(pcl_ms::reconstruct(viewOf(cloud), pcl_ms::Parameters()).triangles.empty());
+  pcl_ms::Parameters gridded;
+  gridded.grid_buckets = 3;
+  try {
+    pcl_ms::reconstruct(viewOf(cloud), gridded);
+    ADD_FAILURE() << "meshed in buckets that cannot see their neighbours";
+  } catch (const pcl_ms::ReconstructionError &error) {
+    EXPECT_NE(std::string(error.what()).find("too many buckets for the cloud: use fewer or none"),
+              std::string::npos)
+        << error.what();
+  }
 }
 
 TEST(Buckets, SameMeshForOneTwoAndEightThreads) {

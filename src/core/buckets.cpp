@@ -33,6 +33,9 @@ double secondsSince(Clock::time_point start) {
 // so that the triangles a seam keeps fixed were decided with points around.
 constexpr double margin_context_in_d_med = 6;
 
+// meshBucket's error for a unit of fewer than 3 points.
+const char *const too_few_points = "fewer than 3 points";
+
 // Nearest-neighbour samples per bucket for the spacing estimate.
 constexpr std::size_t spacing_samples_per_bucket = 32;
 
@@ -403,9 +406,13 @@ public:
       else
         ++surface_.statistics.failed_units;
     }
-    if (bucket_d_meds.empty())
+    if (bucket_d_meds.empty()) {
+      // A few points in a fine grid: margins of the spacing reach no others.
+      if (first_error == too_few_points)
+        first_error += " with its margin (too many buckets for the cloud: use fewer or none)";
       throw ReconstructionError("no bucket could be meshed" +
                                 (first_error.empty() ? std::string() : ": " + first_error));
+    }
     std::nth_element(bucket_d_meds.begin(), bucket_d_meds.begin() + bucket_d_meds.size() / 2,
                      bucket_d_meds.end());
     surface_.d_med = bucket_d_meds[bucket_d_meds.size() / 2];
@@ -716,7 +723,7 @@ BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters,
                          const Deadline *deadline) {
   BucketOutcome outcome;
   if (task.points.size() < 3) {
-    outcome.error = "fewer than 3 points";
+    outcome.error = too_few_points;
     return outcome;
   }
   try {
