@@ -452,53 +452,65 @@ TEST_F(IoLoadPointCloud, DoubleFieldsAreReadAsFloat) {
   }
 }
 
-TEST_F(IoLoadPointCloud, GeoreferencedDoublesAreRefusedNotRounded) {
-  // A terrain patch at UTM coordinates, 0.5 m apart: a float holds a
-  // northing of 5.4e6 to 0.5 m, so rounding would move points by up to a
-  // quarter of a metre. Every reader that rounds doubles refuses it and says
-  // why; the same patch near the origin loads, every point kept.
+/// A 40 x 40 terrain patch, points `spacing` apart (jittered), each
+/// coordinate plus `offset`: as .xyz text, as OFF and as double PLY.
+void writeTerrainPatch(const std::function<std::string(const char *)> &path, const char *stem,
+                       double spacing, const std::array<double, 3> &offset) {
   std::mt19937 random(7);
-  std::uniform_real_distribution<double> jitter(-0.2, 0.2);
-  std::ostringstream utm_xyz, utm_off, local_xyz;
-  std::string utm_ply;
+  std::uniform_real_distribution<double> jitter(-0.4, 0.4);
+  std::ostringstream xyz, off;
+  std::string ply;
   const int side = 40;
-  utm_off << "OFF\n" << side * side << " 0 0\n";
+  off << "OFF\n" << side * side << " 0 0\n";
+  for (std::ostringstream *out : {&xyz, &off})
+    out->precision(12);
   for (int i = 0; i < side; ++i)
     for (int j = 0; j < side; ++j) {
-      const double x = 0.5 * i + jitter(random), y = 0.5 * j + jitter(random);
-      const double z = std::sin(0.2 * i) + 0.1 * jitter(random);
-      const double utm[3] = {512000.0 + x, 5401000.0 + y, 120.0 + z};
-      utm_ply.append(reinterpret_cast<const char *>(utm), sizeof utm);
-      for (std::ostringstream *out : {&utm_xyz, &utm_off, &local_xyz})
-        out->precision(12);
-      utm_xyz << utm[0] << " " << utm[1] << " " << utm[2] << "\n";
-      utm_off << utm[0] << " " << utm[1] << " " << utm[2] << "\n";
-      local_xyz << x << " " << y << " " << z << "\n";
+      const double point[3] = {offset[0] + spacing * (i + jitter(random)),
+                               offset[1] + spacing * (j + jitter(random)),
+                               offset[2] + spacing * (2 * std::sin(0.2 * i) + jitter(random))};
+      ply.append(reinterpret_cast<const char *>(point), sizeof point);
+      xyz << point[0] << " " << point[1] << " " << point[2] << "\n";
+      off << point[0] << " " << point[1] << " " << point[2] << "\n";
     }
-  writeFile(path("utm.xyz"), utm_xyz.str());
-  writeFile(path("utm.off"), utm_off.str());
-  writeFile(path("utm.ply"), "ply\nformat binary_little_endian 1.0\nelement vertex " +
-                                 std::to_string(side * side) +
-                                 "\nproperty double x\nproperty double y\nproperty double z\n"
-                                 "end_header\n" +
-                                 utm_ply);
+  const std::string name = stem;
+  writeFile(path((name + ".xyz").c_str()), xyz.str());
+  writeFile(path((name + ".off").c_str()), off.str());
+  writeFile(path((name + ".ply").c_str()),
+            "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(side * side) +
+                "\nproperty double x\nproperty double y\nproperty double z\nend_header\n" + ply);
+}
+
+TEST_F(IoLoadPointCloud, GeoreferencedDoublesAreRefusedNotRounded) {
+  // UTM coordinates: a float holds a northing of 5.4e6 to half a metre, so
+  // rounding moves points by up to a quarter of a metre. Points 0.5 m apart
+  // would move by half their spacing: every reader that rounds doubles
+  // refuses them and says why. 5 m apart (5 %), or 0.5 m apart on an 8 km
+  // site grid (0.05 %), they load, every point kept.
+  const auto inTemp = [&](const char *name) { return path(name); };
+  writeTerrainPatch(inTemp, "utm", 0.5, {512000.0, 5401000.0, 120.0});
+  writeTerrainPatch(inTemp, "utm_sparse", 5.0, {512000.0, 5401000.0, 120.0});
+  writeTerrainPatch(inTemp, "site", 0.5, {8000.0, 8000.0, 120.0});
   for (const char *name : {"utm.xyz", "utm.off", "utm.ply"}) {
     const std::string error = expectCloudFailure(path(name));
     EXPECT_TRUE(contains(error, "as large as 5.401e+06") && contains(error, "typical spacing") &&
                 contains(error, "shift the cloud near the origin"))
         << error;
   }
-  writeFile(path("local.xyz"), local_xyz.str());
-  pcl::PCLPointCloud2 loaded;
-  std::string error;
-  ASSERT_TRUE(pcl_ms::loadPointCloud(path("local.xyz"), loaded, error)) << error;
-  pcl::PointCloud<pcl::PointXYZ> points;
-  pcl::fromPCLPointCloud2(loaded, points);
-  std::vector<std::array<float, 3>> distinct;
-  for (const pcl::PointXYZ &point : points)
-    distinct.push_back({point.x, point.y, point.z});
-  std::sort(distinct.begin(), distinct.end());
-  EXPECT_EQ(std::unique(distinct.begin(), distinct.end()) - distinct.begin(), side * side);
+  for (const char *name :
+       {"utm_sparse.xyz", "utm_sparse.off", "utm_sparse.ply", "site.xyz", "site.off", "site.ply"}) {
+    SCOPED_TRACE(name);
+    pcl::PCLPointCloud2 loaded;
+    std::string error;
+    ASSERT_TRUE(pcl_ms::loadPointCloud(path(name), loaded, error)) << error;
+    pcl::PointCloud<pcl::PointXYZ> points;
+    pcl::fromPCLPointCloud2(loaded, points);
+    std::vector<std::array<float, 3>> distinct;
+    for (const pcl::PointXYZ &point : points)
+      distinct.push_back({point.x, point.y, point.z});
+    std::sort(distinct.begin(), distinct.end());
+    EXPECT_EQ(std::unique(distinct.begin(), distinct.end()) - distinct.begin(), 1600);
+  }
 }
 
 TEST_F(IoLoadPointCloud, DoubleOutOfFloatRangeIsNamed) {

@@ -17,8 +17,10 @@ namespace pcl_ms {
 namespace io_detail {
 
 /// Rounding moves no point by more than this share of the cloud's typical
-/// spacing (its median nearest-neighbour distance).
-constexpr double max_rounding_per_spacing = 0.01;
+/// spacing (its median nearest-neighbour distance): about a scanner's noise
+/// at that spacing. A site grid of 5 km at 1 cm spacing (2.4 %) or UTM at
+/// 5 m (5 %) passes; UTM at 1 m (25 %) does not.
+constexpr double max_rounding_per_spacing = 0.1;
 
 /// Rounds coordinates to float, one at a time, and remembers how far the
 /// farthest moved and the bounding box of the values as read.

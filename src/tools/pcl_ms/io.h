@@ -31,7 +31,7 @@ namespace pcl_ms {
 /// On success `cloud` has FLOAT32 fields x, y, z (plus whatever else the file
 /// holds) and at least one point: coordinates read as double (text, mesh
 /// files, FLOAT64 PCD or PLY fields, narrowed in place with FLOAT64 normals)
-/// are rounded, and the file is refused when that moves points by over 1 %
+/// are rounded, and the file is refused when that moves points by over 10 %
 /// of their typical spacing (float_coordinates.h). On failure `cloud` is
 /// left empty.
 /// `sensor_origin`, when given, receives a PCD file's VIEWPOINT position
