@@ -7,6 +7,7 @@
 #include <pcl_ms/mesh_points.h>
 #include <pcl_ms/reconstruct.h>
 
+#include "median_spacing.h"
 #include "threads.h"
 
 #include <tbb/blocked_range.h>
@@ -251,25 +252,12 @@ private:
   Eigen::Vector3d grid_low_ = Eigen::Vector3d::Zero(), grid_cell_ = Eigen::Vector3d::Ones();
 };
 
-/// The median nearest-neighbour distance from a few of `members` to the
-/// others; 0 for fewer than 2 members.
+/// The median spacing of `members` (detail::medianSpacing); 0 for fewer
+/// than 2 members.
 double medianSpacing(const std::vector<Eigen::Vector3d> &points,
                      const std::vector<VertexIndex> &members) {
-  std::vector<double> distances;
-  const std::size_t samples =
-      members.size() < 2 ? 0 : std::min(spacing_samples_per_bucket, members.size());
-  for (std::size_t s = 0; s < samples; ++s) {
-    const VertexIndex query = members[s * members.size() / samples];
-    double nearest = std::numeric_limits<double>::infinity();
-    for (VertexIndex other : members)
-      if (other != query)
-        nearest = std::min(nearest, (points[other] - points[query]).squaredNorm());
-    distances.push_back(std::sqrt(nearest));
-  }
-  if (distances.empty())
-    return 0;
-  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
-  return distances[distances.size() / 2];
+  return detail::medianSpacing(members.size(), spacing_samples_per_bucket,
+                               [&](std::size_t i) { return points[members[i]]; });
 }
 
 /// For each bucket, its median spacing (a bucket is big enough for this):

@@ -2,6 +2,8 @@
 // Coordinates rounded to float, and whether that harmed the cloud.
 #include "float_coordinates.h"
 
+#include "median_spacing.h"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -17,31 +19,6 @@ constexpr double negligible_rounding_per_size = 1e-6;
 
 // Points whose nearest neighbour gives the spacing estimate.
 constexpr std::size_t spacing_samples = 64;
-
-/// The median distance from sample points to their nearest point at another
-/// position, or 0 when no point has a neighbour.
-double medianSpacing(const std::vector<Eigen::Vector3f> &points) {
-  std::vector<double> nearest;
-  const std::size_t samples = std::min(spacing_samples, points.size());
-  for (std::size_t s = 0; s < samples; ++s) {
-    const Eigen::Vector3f &query = points[s * points.size() / samples];
-    if (!query.allFinite())
-      continue;
-    double best = std::numeric_limits<double>::infinity();
-    for (const Eigen::Vector3f &other : points) {
-      const double distance = (other.cast<double>() - query.cast<double>()).squaredNorm();
-      if (distance > 0 && distance < best) // NaN compares false
-        best = distance;
-    }
-    if (std::isfinite(best))
-      nearest.push_back(std::sqrt(best));
-  }
-  if (nearest.empty())
-    return 0;
-  auto middle = nearest.begin() + static_cast<std::ptrdiff_t>(nearest.size() / 2);
-  std::nth_element(nearest.begin(), middle, nearest.end());
-  return *middle;
-}
 
 } // namespace
 
@@ -68,7 +45,8 @@ bool CoordinateRounding::harmless(std::size_t count,
   std::vector<Eigen::Vector3f> points(count);
   for (std::size_t i = 0; i < count; ++i)
     points[i] = rounded(i);
-  const double spacing = medianSpacing(points);
+  const double spacing = detail::medianSpacing(
+      count, spacing_samples, [&](std::size_t i) { return points[i].cast<double>().eval(); });
   if (spacing > 0 && largest_shift_ <= max_rounding_per_spacing * spacing)
     return true;
   std::ostringstream message;
