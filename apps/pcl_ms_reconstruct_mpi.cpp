@@ -2,8 +2,9 @@
 // pcl_ms_reconstruct_mpi: pcl_ms_reconstruct across the ranks of an MPI job,
 // with the same options and the same triangles for any number of ranks.
 //
-// The ranks read their own byte ranges of a binary PCD or PLY and send them
-// to rank 0 (other formats: rank 0 reads). Rank 0 prepares the points, builds
+// The ranks read their own byte ranges of a binary PCD or PLY and prepare
+// them together (pcl_ms::preparePointsTogether), then send the prepared
+// points to rank 0 (other formats: rank 0 reads and prepares). Rank 0 builds
 // the bucket tree and hands each bucket and seam zone as a task to a free
 // rank (pcl_ms_mpi::MpiUnitFarm), meshing one itself meanwhile; the other
 // ranks hold one unit at a time, never the cloud (docs/algorithm.md,
@@ -17,17 +18,20 @@
 // job, so no rank waits for it.
 #include "mpi_bucket_exchange.h"
 #include "mpi_cloud_reader.h"
+#include "mpi_process_group.h"
 #include "reconstruct_cli.h"
 #include "tool_support.h"
 
 #include <pcl_ms/io.h>
 #include <pcl_ms/medial_scaffold_reconstruction.h>
+#include <pcl_ms/prepared_points.h>
 #include <pcl_ms/reconstruct.h>
 
 #include <pcl/conversions.h>
 #include <pcl/point_types.h>
 
 #include <mpi.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
@@ -38,6 +42,7 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -112,14 +117,20 @@ struct SliceStatus {
   int readers = 1;    // ranks that read a part
 };
 
+/// This rank's records of a file read in parts: the cloud's records
+/// [first_record, first_record + points.size()).
+template <typename PointT> struct CloudPart {
+  pcl::PointCloud<PointT> points;
+  std::uint64_t first_record = 0;
+};
+
 /// Every rank reads the records of its own byte range of a binary PCD or PLY
-/// and sends them to rank 0, which alone ends with all points (docs/algorithm.md,
-/// "Across processes"). A range the file does not hold fails on its rank,
-/// with the reason there, and every rank returns kIoFailure.
+/// (docs/algorithm.md, "Across processes"). A range the file does not hold
+/// fails on its rank, with the reason there, and every rank returns
+/// kIoFailure.
 template <typename PointT>
-SliceStatus readCloudInParts(const Job &job, const std::string &path,
-                             const pcl_ms_mpi::BinaryCloudLayout &layout,
-                             pcl::PointCloud<PointT> &points) {
+SliceStatus readOwnPart(const Job &job, const std::string &path,
+                        const pcl_ms_mpi::BinaryCloudLayout &layout, CloudPart<PointT> &part) {
   // Without a shared filesystem the other ranks may not see the file (or
   // see another): then rank 0 reads it all.
   std::error_code code;
@@ -127,10 +138,10 @@ SliceStatus readCloudInParts(const Job &job, const std::string &path,
   int all_see = 0;
   MPI_Allreduce(&sees, &all_see, 1, MPI_INT, MPI_MIN, job.communicator);
   const int readers = all_see ? job.ranks : 1;
-  const auto firstOf = [&](int rank) {
-    return pcl_ms_mpi::firstRecordOf(std::min(rank, readers), readers, layout.points);
-  };
-  const std::uint64_t begin = firstOf(job.rank), end = firstOf(job.rank + 1);
+  const std::uint64_t begin =
+      pcl_ms_mpi::firstRecordOf(std::min(job.rank, readers), readers, layout.points);
+  const std::uint64_t end =
+      pcl_ms_mpi::firstRecordOf(std::min(job.rank + 1, readers), readers, layout.points);
   SliceStatus mine;
   mine.readers = readers;
   std::vector<unsigned char> bytes;
@@ -145,39 +156,53 @@ SliceStatus readCloudInParts(const Job &job, const std::string &path,
   MPI_Allreduce(&mine.code, &all.code, 1, MPI_INT, MPI_MAX, job.communicator);
   if (all.code != kSuccess)
     return all;
-  // Rank 0 holds the whole cloud, the others their range only.
-  const std::uint64_t first_held = job.rank == 0 ? 0 : begin;
-  points.resize(job.rank == 0 ? layout.points : end - begin);
+  part.first_record = begin;
+  part.points.resize(end - begin);
   auto field = [&](std::size_t record, std::uint32_t offset) {
     float value;
     std::memcpy(&value, bytes.data() + record * layout.record_bytes + offset, sizeof value);
     return value;
   };
-  for (std::uint64_t i = begin; i < end; ++i) {
-    PointT &point = points[i - first_held];
-    point.x = field(i - begin, layout.xyz[0]);
-    point.y = field(i - begin, layout.xyz[1]);
-    point.z = field(i - begin, layout.xyz[2]);
+  for (std::size_t i = 0; i < part.points.size(); ++i) {
+    PointT &point = part.points[i];
+    point.x = field(i, layout.xyz[0]);
+    point.y = field(i, layout.xyz[1]);
+    point.z = field(i, layout.xyz[2]);
     mine.all_finite &= std::isfinite(point.x) && std::isfinite(point.y) && std::isfinite(point.z);
     if constexpr (pcl::traits::has_normal_v<PointT>)
       if (layout.hasNormals()) {
-        point.normal_x = field(i - begin, static_cast<std::uint32_t>(layout.normal[0]));
-        point.normal_y = field(i - begin, static_cast<std::uint32_t>(layout.normal[1]));
-        point.normal_z = field(i - begin, static_cast<std::uint32_t>(layout.normal[2]));
+        point.normal_x = field(i, static_cast<std::uint32_t>(layout.normal[0]));
+        point.normal_y = field(i, static_cast<std::uint32_t>(layout.normal[1]));
+        point.normal_z = field(i, static_cast<std::uint32_t>(layout.normal[2]));
       }
   }
-  std::vector<unsigned char>().swap(bytes);
-  for (int r = 1; r < readers; ++r) {
-    const std::uint64_t first = firstOf(r), last = firstOf(r + 1);
-    if (job.rank == 0)
-      pcl_ms_mpi::receiveBytes(points.data() + first, (last - first) * sizeof(PointT), r,
-                               job.communicator);
-    else if (job.rank == r)
-      pcl_ms_mpi::sendBytes(points.data(), points.size() * sizeof(PointT), 0, job.communicator);
-  }
-  if (job.rank != 0)
-    pcl::PointCloud<PointT>().swap(points);
   MPI_Allreduce(&mine.all_finite, &all.all_finite, 1, MPI_INT, MPI_MIN, job.communicator);
+  return all;
+}
+
+/// Rank 0 gets every rank's part, in record order (the others' go).
+template <typename PointT>
+pcl::PointCloud<PointT> joinPartsOnRankZero(const Job &job, CloudPart<PointT> &&part,
+                                            std::uint64_t records) {
+  std::vector<std::uint64_t> firsts(static_cast<std::size_t>(job.ranks), 0);
+  MPI_Gather(&part.first_record, 1, MPI_UINT64_T, firsts.data(), 1, MPI_UINT64_T, 0,
+             job.communicator);
+  pcl::PointCloud<PointT> all;
+  if (job.rank == 0) {
+    all.resize(records);
+    std::copy(part.points.begin(), part.points.end(), all.begin());
+    for (int r = 1; r < job.ranks; ++r) {
+      const std::uint64_t first = firsts[static_cast<std::size_t>(r)];
+      const std::uint64_t end =
+          r + 1 < job.ranks ? firsts[static_cast<std::size_t>(r + 1)] : records;
+      pcl_ms_mpi::receiveBytes(all.data() + first, (std::max(end, first) - first) * sizeof(PointT),
+                               r, job.communicator);
+    }
+  } else {
+    pcl_ms_mpi::sendBytes(part.points.data(), part.points.size() * sizeof(PointT), 0,
+                          job.communicator);
+  }
+  pcl::PointCloud<PointT>().swap(part.points);
   return all;
 }
 
@@ -215,6 +240,23 @@ pcl_ms::Result meshWithInitialTriangles(const Job &job, pcl::PointCloud<PointT> 
   return reconstruction.getResult();
 }
 
+/// The points of `cloud` as pcl::MedialScaffoldReconstruction passes them:
+/// no indices, normals from the point type.
+template <typename PointT>
+pcl_ms::PointView viewOfCloud(const pcl::PointCloud<PointT> &cloud, bool use_normals) {
+  pcl_ms::PointView view;
+  view.xyz = cloud.empty() ? nullptr : &cloud[0].x;
+  view.size = cloud.size();
+  view.stride = sizeof(PointT);
+  if constexpr (pcl::traits::has_normal_v<PointT>) {
+    if (use_normals) {
+      view.normals = cloud.empty() ? nullptr : &cloud[0].normal_x;
+      view.normal_stride = sizeof(PointT);
+    }
+  }
+  return view;
+}
+
 /// Rank 0: meshes `points`, with the other ranks meshing the units it
 /// hands out, and frees them as soon as the core has prepared its copy.
 template <typename PointT>
@@ -225,25 +267,95 @@ pcl_ms::Result meshPoints(const Job &job, pcl::PointCloud<PointT> &&points,
     pcl::PointCloud<PointT>().swap(owned);
     returnFreeMemory();
   });
-  // As pcl::MedialScaffoldReconstruction passes them: no indices, normals
-  // from the point type.
-  pcl_ms::PointView view;
-  view.xyz = owned.empty() ? nullptr : &owned[0].x;
-  view.size = owned.size();
-  view.stride = sizeof(PointT);
-  if constexpr (pcl::traits::has_normal_v<PointT>) {
-    if (parameters.use_normals) {
-      view.normals = owned.empty() ? nullptr : &owned[0].normal_x;
-      view.normal_stride = sizeof(PointT);
-    }
-  }
   try {
-    pcl_ms::Result result = pcl_ms::reconstruct(view, parameters, exchange);
+    pcl_ms::Result result =
+        pcl_ms::reconstruct(viewOfCloud(owned, parameters.use_normals), parameters, exchange);
     exchange.onPointsPrepared({});
     return result;
   } catch (const std::exception &error) {
     abortJob(job, kReconstructionFailure, std::string("reconstruction failed: ") + error.what());
   }
+}
+
+/// Rank 0: meshes the points the ranks prepared together, the other ranks
+/// meshing the units it hands out.
+pcl_ms::Result meshPrepared(const Job &job, pcl_ms::PreparedPoints &&points,
+                            const pcl_ms::PreparationCounts &counts,
+                            const pcl_ms::Parameters &parameters,
+                            pcl_ms_mpi::MpiUnitFarm &exchange) {
+  try {
+    return pcl_ms::reconstructPrepared(std::move(points), counts, parameters, exchange);
+  } catch (const std::exception &error) {
+    abortJob(job, kReconstructionFailure, std::string("reconstruction failed: ") + error.what());
+  }
+}
+
+/// Every rank prepares its part together with the others (NaN, duplicates,
+/// far points, the order: docs/algorithm.md, "Across processes"), so that
+/// no rank holds the cloud's records; the part is freed. An unusable cloud
+/// (too few points, ...) fails alike on every rank: the status is returned
+/// everywhere, with the reason printed by rank 0.
+template <typename PointT>
+int prepareParts(const Job &job, CloudPart<PointT> &&part, const pcl_ms::Parameters &parameters,
+                 pcl_ms::PreparedSlice &slice) {
+  pcl_ms_mpi::MpiProcessGroup group(job.communicator);
+  std::string error;
+  try {
+    tbb::task_arena arena(std::max(1, parameters.num_threads));
+    arena.execute([&] {
+      slice = pcl_ms::preparePointsTogether(viewOfCloud(part.points, parameters.use_normals),
+                                            part.first_record, parameters.use_normals, group);
+    });
+  } catch (const pcl_ms::ReconstructionError &unusable) {
+    error = unusable.what();
+  } catch (const std::exception &unexpected) {
+    abortJob(job, kReconstructionFailure,
+             std::string("reconstruction failed: ") + unexpected.what());
+  }
+  pcl::PointCloud<PointT>().swap(part.points);
+  returnFreeMemory();
+  if (error.empty())
+    return kSuccess;
+  return job.rank == 0 ? fail(kReconstructionFailure, "reconstruction failed: " + error)
+                       : kReconstructionFailure;
+}
+
+/// Rank 0 gets every rank's slice of the prepared points, joined in rank
+/// order (the order of one process); the other ranks send theirs and get
+/// nothing.
+pcl_ms::PreparedPoints joinSlicesOnRankZero(const Job &job, pcl_ms::PreparedSlice &&slice,
+                                            bool with_normals) {
+  pcl_ms::PreparedPoints points = std::move(slice.points);
+  std::uint64_t count = points.positions.size();
+  std::vector<std::uint64_t> counts(static_cast<std::size_t>(job.ranks), 0);
+  MPI_Gather(&count, 1, MPI_UINT64_T, counts.data(), 1, MPI_UINT64_T, 0, job.communicator);
+  if (job.rank != 0) {
+    pcl_ms_mpi::sendBytes(points.positions.data(), count * sizeof(Eigen::Vector3d), 0,
+                          job.communicator);
+    pcl_ms_mpi::sendBytes(points.user_index.data(), count * sizeof(pcl_ms::VertexIndex), 0,
+                          job.communicator);
+    pcl_ms_mpi::sendBytes(points.normals.data(), points.normals.size() * sizeof(Eigen::Vector3f), 0,
+                          job.communicator);
+    return {};
+  }
+  // Rank 0's slice comes first; the others follow it in rank order.
+  points.positions.resize(slice.total);
+  points.user_index.resize(slice.total);
+  if (with_normals)
+    points.normals.resize(slice.total);
+  std::size_t first = count;
+  for (int r = 1; r < job.ranks; ++r) {
+    const std::uint64_t theirs = counts[static_cast<std::size_t>(r)];
+    pcl_ms_mpi::receiveBytes(points.positions.data() + first, theirs * sizeof(Eigen::Vector3d), r,
+                             job.communicator);
+    pcl_ms_mpi::receiveBytes(points.user_index.data() + first, theirs * sizeof(pcl_ms::VertexIndex),
+                             r, job.communicator);
+    if (with_normals)
+      pcl_ms_mpi::receiveBytes(points.normals.data() + first, theirs * sizeof(Eigen::Vector3f), r,
+                               job.communicator);
+    first += theirs;
+  }
+  return points;
 }
 
 /// How the input reaches the ranks; rank 0 decides, every rank gets it.
@@ -261,7 +373,11 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
                     double load_ms) {
   const bool on_rank_zero = job.rank == 0;
   const bool verbose = on_rank_zero && !options.quiet;
-  pcl::PointCloud<PointT> points;
+  pcl::PointCloud<PointT> points; // rank 0's whole cloud, unless the ranks prepare parts
+  // Read in parts (without initial triangles, which need the whole cloud on
+  // rank 0): each rank's slice of the points, prepared together.
+  std::optional<pcl_ms::PreparedSlice> slice;
+  double prepare_seconds = 0;
   SliceStatus read;
   if (input.in_parts) {
     if (verbose) {
@@ -269,7 +385,8 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
       print_value("%s ", options.input.c_str());
     }
     const auto read_start = std::chrono::steady_clock::now();
-    read = readCloudInParts(job, options.input, input.layout, points);
+    CloudPart<PointT> part;
+    read = readOwnPart(job, options.input, input.layout, part);
     if (read.code != kSuccess) {
       if (verbose)
         print_info("[failed]\n");
@@ -282,18 +399,36 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
       print_info("[done, ");
       print_value("%.1f", load_ms);
       print_info(" ms : ");
-      print_value("%zu", points.size());
+      print_value("%zu", static_cast<std::size_t>(input.layout.points));
       print_info(" points, ");
       print_value("%d", read.readers);
       print_info(read.readers == 1 ? " part]\n" : " parts]\n");
       print_info("Available dimensions: ");
       print_value("%s\n", fields.c_str());
     }
+    if (initial.empty()) {
+      const auto prepare_start = std::chrono::steady_clock::now();
+      slice.emplace();
+      const int prepared = prepareParts(job, std::move(part), parameters, *slice);
+      if (prepared != kSuccess)
+        return prepared;
+      prepare_seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - prepare_start).count();
+    } else {
+      points = joinPartsOnRankZero(job, std::move(part), input.layout.points);
+    }
   } else if (on_rank_zero) {
     SilencePclMessages silence;
     pcl::fromPCLPointCloud2(cloud, points);
   }
   const double read_mb = peakResidentMegabytes();
+  pcl_ms::PreparedPoints prepared;
+  pcl_ms::PreparationCounts counts;
+  if (slice) {
+    counts = slice->counts;
+    prepared = joinSlicesOnRankZero(job, std::move(*slice), parameters.use_normals);
+    slice.reset();
+  }
 
   if (!on_rank_zero) {
     // The other ranks mesh the units rank 0 sends them, one at a time.
@@ -332,8 +467,13 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
                    secondsSinceStart());
   });
   pcl_ms::Result result =
-      initial.empty() ? meshPoints(job, std::move(points), parameters, exchange)
-                      : meshWithInitialTriangles(job, std::move(points), parameters, initial);
+      !initial.empty() ? meshWithInitialTriangles(job, std::move(points), parameters, initial)
+      : input.in_parts ? meshPrepared(job, std::move(prepared), counts, parameters, exchange)
+                       : meshPoints(job, std::move(points), parameters, exchange);
+  if (input.in_parts && initial.empty()) {
+    result.timings.prepare = prepare_seconds;
+    result.timings.total += prepare_seconds;
+  }
   exchange.release(); // the other ranks are done
   const double reconstruct_seconds = secondsSinceStart();
   if (verbose) {

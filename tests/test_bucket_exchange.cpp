@@ -2,6 +2,7 @@
 // pcl_ms::BucketExchange without MPI: threads stand in for processes, so
 // the sharing of buckets and seams (docs/algorithm.md, "Across processes")
 // is checked in every build, sanitizers included.
+#include "core/thread_processes.h"
 #include "test_support.h"
 
 #include <pcl_ms/buckets.h>
@@ -9,42 +10,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <condition_variable>
 #include <limits>
-#include <mutex>
 #include <thread>
 
 namespace {
 
 using namespace pcl_ms_test;
-
-/// What the "processes" share: a barrier and one posted pointer each.
-class Hub {
-public:
-  explicit Hub(int processes) : processes_(processes), posted_(processes, nullptr) {}
-
-  void wait() {
-    std::unique_lock<std::mutex> lock(mutex_);
-    const std::size_t generation = generation_;
-    if (++waiting_ == processes_) {
-      waiting_ = 0;
-      ++generation_;
-      changed_.notify_all();
-    } else {
-      changed_.wait(lock, [&] { return generation_ != generation; });
-    }
-  }
-  int processes() const { return processes_; }
-  std::vector<void *> &posted() { return posted_; }
-
-private:
-  const int processes_;
-  std::vector<void *> posted_;
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  int waiting_ = 0;
-  std::size_t generation_ = 0;
-};
 
 class ThreadExchange : public pcl_ms::BucketExchange {
 public:
@@ -83,7 +54,7 @@ private:
     hub_.wait();
     std::vector<Value> combined = values;
     for (int other = 0; other < hub_.processes(); ++other) {
-      const auto &theirs = *static_cast<std::vector<Value> *>(hub_.posted()[other]);
+      const auto &theirs = *static_cast<const std::vector<Value> *>(hub_.posted()[other]);
       if (theirs.size() != values.size()) { // not ASSERT: the others wait at the barrier
         ADD_FAILURE() << "process " << other << " has " << theirs.size() << " values";
         continue;

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 namespace pcl_ms {
 namespace detail {
@@ -24,13 +25,52 @@ double distanceToBox(const Eigen::Vector3d &p, const Eigen::Vector3d &low,
 
 } // namespace
 
+std::size_t tailRank(std::size_t n) {
+  return static_cast<std::size_t>(tail_fraction * static_cast<double>(n));
+}
+
+bool outsideCentralBox(const Eigen::Vector3f &p, const Eigen::Vector3d &low,
+                       const Eigen::Vector3d &high, double size) {
+  return size > 0 && std::isfinite(size) && distanceToBox(p.cast<double>(), low, high) > size;
+}
+
+std::vector<bool> isolatedOutside(std::vector<Eigen::Vector3f> outside, const Eigen::Vector3d &low,
+                                  const Eigen::Vector3d &high, double size) {
+  // Swept along x: a neighbour within `size` is within `size` in x.
+  std::vector<std::size_t> order(outside.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return outside[a].x() < outside[b].x(); });
+  std::vector<bool> isolated(outside.size(), false);
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const Eigen::Vector3d p = outside[order[k]].cast<double>();
+    if (distanceToBox(p, low, high) <= 2 * size)
+      continue;
+    bool has_neighbour = false;
+    for (std::size_t j = k + 1; !has_neighbour && j < order.size(); ++j) {
+      const Eigen::Vector3d q = outside[order[j]].cast<double>();
+      if (q.x() - p.x() > size)
+        break;
+      has_neighbour = (q - p).norm() <= size;
+    }
+    for (std::size_t j = k; !has_neighbour && j-- > 0;) {
+      const Eigen::Vector3d q = outside[order[j]].cast<double>();
+      if (p.x() - q.x() > size)
+        break;
+      has_neighbour = (q - p).norm() <= size;
+    }
+    isolated[order[k]] = !has_neighbour;
+  }
+  return isolated;
+}
+
 FarPoints findFarPoints(const std::vector<Eigen::Vector3f> &points) {
   FarPoints far;
   far.is_far.assign(points.size(), false);
   if (points.empty())
     return far;
   const std::size_t n = points.size();
-  const auto tail = static_cast<std::size_t>(tail_fraction * static_cast<double>(n));
+  const std::size_t tail = tailRank(n);
   Eigen::Vector3d central_low, central_high;
   // The axes are independent selections: one thread each.
   tbb::parallel_for(0, 3, [&](int axis) {
@@ -40,7 +80,7 @@ FarPoints findFarPoints(const std::vector<Eigen::Vector3f> &points) {
     auto at = [&](std::size_t k) {
       std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k),
                        values.end());
-      return static_cast<double>(values[k]);
+      return selectedValue(values[k]);
     };
     central_low[axis] = at(tail);
     central_high[axis] = at(n - 1 - tail);
@@ -50,35 +90,19 @@ FarPoints findFarPoints(const std::vector<Eigen::Vector3f> &points) {
   // Only points beyond `size` from the central box can be within `size` of a
   // candidate (beyond 2 size): every other point is farther than that.
   std::vector<std::size_t> outside;
-  if (size > 0 && std::isfinite(size))
-    for (std::size_t i = 0; i < n; ++i)
-      if (distanceToBox(points[i].cast<double>(), central_low, central_high) > size)
-        outside.push_back(i);
-  // Swept along x: a neighbour within `size` is within `size` in x.
-  std::sort(outside.begin(), outside.end(),
-            [&](std::size_t a, std::size_t b) { return points[a].x() < points[b].x(); });
-  for (std::size_t k = 0; k < outside.size(); ++k) {
-    const Eigen::Vector3d p = points[outside[k]].cast<double>();
-    if (distanceToBox(p, central_low, central_high) <= 2 * size)
-      continue;
-    bool has_neighbour = false;
-    for (std::size_t j = k + 1; !has_neighbour && j < outside.size(); ++j) {
-      const Eigen::Vector3d q = points[outside[j]].cast<double>();
-      if (q.x() - p.x() > size)
-        break;
-      has_neighbour = (q - p).norm() <= size;
+  std::vector<Eigen::Vector3f> outside_points;
+  for (std::size_t i = 0; i < n; ++i)
+    if (outsideCentralBox(points[i], central_low, central_high, size)) {
+      outside.push_back(i);
+      outside_points.push_back(points[i]);
     }
-    for (std::size_t j = k; !has_neighbour && j-- > 0;) {
-      const Eigen::Vector3d q = points[outside[j]].cast<double>();
-      if (p.x() - q.x() > size)
-        break;
-      has_neighbour = (q - p).norm() <= size;
-    }
-    if (!has_neighbour) {
+  const std::vector<bool> isolated =
+      isolatedOutside(std::move(outside_points), central_low, central_high, size);
+  for (std::size_t k = 0; k < outside.size(); ++k)
+    if (isolated[k]) {
       far.is_far[outside[k]] = true;
       ++far.count;
     }
-  }
 
   // The median of the points kept, so that far points change nothing.
   tbb::parallel_for(0, 3, [&](int axis) {
@@ -89,7 +113,7 @@ FarPoints findFarPoints(const std::vector<Eigen::Vector3f> &points) {
         values.push_back(points[i][axis]);
     auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
     std::nth_element(values.begin(), middle, values.end());
-    far.median[axis] = *middle;
+    far.median[axis] = selectedValue(*middle);
   });
   far.low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   far.high = -far.low;

@@ -30,5 +30,28 @@ struct FarPoints {
 /// diagonal). A distant group of points is kept; a lone stray point is not.
 FarPoints findFarPoints(const std::vector<Eigen::Vector3f> &points);
 
+// The pieces of findFarPoints that processes sharing a cloud run alike
+// (prepare_together.cpp): they select the same values across processes.
+
+/// The rank, among n values of one axis, of the central box's low side; its
+/// high side is the value of rank n - 1 - tailRank(n).
+std::size_t tailRank(std::size_t n);
+
+/// A selected coordinate as the box and centre use it: -0 becomes +0, so
+/// that the result does not depend on which of two equal values a
+/// selection returns.
+inline double selectedValue(float value) { return static_cast<double>(value) + 0.0; }
+
+/// Whether p is farther than `size` from the central box: only such points
+/// can be far, or a far point's neighbour (size: the box's diagonal).
+bool outsideCentralBox(const Eigen::Vector3f &p, const Eigen::Vector3d &low,
+                       const Eigen::Vector3d &high, double size);
+
+/// For each point outside the central box: whether it is far, i.e. beyond
+/// twice `size` from the box with no other of them within `size`. Does not
+/// depend on their order.
+std::vector<bool> isolatedOutside(std::vector<Eigen::Vector3f> outside, const Eigen::Vector3d &low,
+                                  const Eigen::Vector3d &high, double size);
+
 } // namespace detail
 } // namespace pcl_ms

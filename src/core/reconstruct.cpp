@@ -7,10 +7,11 @@
 #include <pcl_ms/finish.h>
 #include <pcl_ms/medial_axis.h>
 #include <pcl_ms/mesh_points.h>
+#include <pcl_ms/prepared_points.h>
 #include <pcl_ms/reconstruct.h>
 
 #include "far_points.h"
-#include "morton.h"
+#include "point_keys.h"
 #include "threads.h"
 
 #include <tbb/parallel_sort.h>
@@ -104,25 +105,21 @@ void returnFreeHeapPages() {
 #endif
 }
 
-/// The distinct, finite points of the user's records, centred on their
-/// bounding box, and for each the user record it stands for.
-struct PreparedPoints {
-  std::vector<Eigen::Vector3d> positions;
-  std::vector<Eigen::Vector3f> normals;
-  std::vector<VertexIndex> user_index;
-  /// Subtracted from the user's coordinates.
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  /// For each user record, its distinct point (duplicates share one), or
-  /// not_prepared for records left out (NaN/Inf, not in the indices). Only
-  /// built when asked for: initial triangles need it.
-  std::vector<VertexIndex> prepared_of_record;
-};
+} // namespace
+
+std::string tooFewPoints(const PreparationCounts &counts, std::size_t distinct) {
+  std::ostringstream reason;
+  reason << "need at least 3 distinct valid points, got " << distinct << " (" << counts.input_points
+         << " given, " << counts.invalid_points << " NaN/Inf, " << counts.duplicate_points
+         << " duplicates, " << counts.far_points << " far stray points)";
+  return reason.str();
+}
+
+namespace {
 
 constexpr VertexIndex not_prepared = std::numeric_limits<VertexIndex>::max();
 
-const float *recordAt(const float *base, std::size_t stride, std::size_t record) {
-  return reinterpret_cast<const float *>(reinterpret_cast<const char *>(base) + record * stride);
-}
+} // namespace
 
 /// Prepares the distinct, finite points in Morton (Z-curve) order. Every
 /// later stage walks the points' neighbourhoods: with neighbours at nearby
@@ -151,7 +148,7 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
                                   std::to_string(view.size) + " points");
       record = static_cast<std::size_t>(index);
     }
-    const float *p = recordAt(view.xyz, view.stride, record);
+    const float *p = detail::recordAt(view.xyz, view.stride, record);
     if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))
       records.push_back(static_cast<VertexIndex>(record));
     else
@@ -164,7 +161,7 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
   {
     std::vector<Eigen::Vector3f> finite(records.size());
     for (std::size_t i = 0; i < records.size(); ++i)
-      finite[i] = Eigen::Vector3f(recordAt(view.xyz, view.stride, records[i]));
+      finite[i] = Eigen::Vector3f(detail::recordAt(view.xyz, view.stride, records[i]));
     far = detail::findFarPoints(finite);
   }
   result.far_points = far.count;
@@ -175,31 +172,11 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
         records[kept++] = records[i];
     records.resize(kept);
   }
-  const Eigen::Vector3d &low = far.low, &high = far.high;
-
-  struct Key {
-    std::uint64_t morton;
-    std::array<float, 3> coordinates;
-    VertexIndex record;
-    bool operator<(const Key &other) const {
-      return std::tie(morton, coordinates, record) <
-             std::tie(other.morton, other.coordinates, other.record);
-    }
-  };
-  std::vector<Key> keys(records.size());
+  std::vector<detail::PointKey> keys(records.size());
   {
-    constexpr double cells_per_axis = 1 << 21;
-    const Eigen::Vector3d extent = (high - low).cwiseMax(Eigen::Vector3d::Constant(1e-300));
-    auto cell = [&](double value, int axis) {
-      const double unit = std::clamp((value - low[axis]) / extent[axis], 0.0, 1.0);
-      return static_cast<std::uint32_t>(std::min(unit * cells_per_axis, cells_per_axis - 1));
-    };
-    for (std::size_t i = 0; i < records.size(); ++i) {
-      const float *p = recordAt(view.xyz, view.stride, records[i]);
-      keys[i] = {detail::mortonCode(cell(p[0], 0), cell(p[1], 1), cell(p[2], 2)),
-                 {p[0], p[1], p[2]},
-                 records[i]};
-    }
+    const detail::MortonCells cells(far.low, far.high);
+    for (std::size_t i = 0; i < records.size(); ++i)
+      keys[i] = cells.key(detail::recordAt(view.xyz, view.stride, records[i]), records[i]);
   }
   records.clear();
   records.shrink_to_fit();
@@ -215,7 +192,7 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
   if (with_normals)
     prepared.normals.reserve(keys.size());
   for (std::size_t i = 0; i < keys.size(); ++i) {
-    const Key &key = keys[i];
+    const detail::PointKey &key = keys[i];
     if (i > 0 && key.coordinates == keys[i - 1].coordinates) {
       // An exact duplicate of the record kept just before.
       ++result.duplicate_points;
@@ -231,26 +208,19 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
         Eigen::Vector3d(key.coordinates[0], key.coordinates[1], key.coordinates[2]) - centre);
     prepared.user_index.push_back(key.record);
     if (with_normals) {
-      const float *n = recordAt(view.normals, view.normal_stride, key.record);
-      Eigen::Vector3f normal(n[0], n[1], n[2]);
-      const float length = normal.norm();
-      // An unusable normal is zero: it then neither helps nor penalises.
-      prepared.normals.push_back(std::isfinite(length) && length > 0
-                                     ? Eigen::Vector3f(normal / length)
-                                     : Eigen::Vector3f::Zero());
+      prepared.normals.push_back(
+          detail::unitNormalOrZero(detail::recordAt(view.normals, view.normal_stride, key.record)));
     }
   }
   result.used_points = prepared.positions.size();
-  if (prepared.positions.size() < 3) {
-    std::ostringstream reason;
-    reason << "need at least 3 distinct valid points, got " << prepared.positions.size() << " ("
-           << count << " given, " << result.invalid_points << " NaN/Inf, "
-           << result.duplicate_points << " duplicates, " << result.far_points
-           << " far stray points)";
-    throw ReconstructionError(reason.str());
-  }
+  if (prepared.positions.size() < 3)
+    throw ReconstructionError(
+        tooFewPoints({count, result.invalid_points, result.duplicate_points, result.far_points},
+                     prepared.positions.size()));
   return prepared;
 }
+
+namespace {
 
 /// Preferred initial triangles in distinct-point indices, corners
 /// ascending, each once (docs/algorithm.md, "Initial triangles"): the
@@ -345,6 +315,19 @@ std::vector<Triangle> prepareInitialTriangles(const std::vector<Triangle> &initi
 Result reconstructShared(const PointView &points, const Parameters &parameters,
                          const std::vector<Triangle> &initial_triangles, BucketExchange &exchange);
 
+Result meshPrepared(const PreparedPoints &prepared, const std::vector<Triangle> &initial_triangles,
+                    const Parameters &parameters, BucketExchange &exchange,
+                    const Deadline &deadline, Clock::time_point start, Result result);
+
+/// The checks every entry point makes before any work.
+void checkParameters(const Parameters &parameters, bool has_normals) {
+  const std::string invalid = parameters.validate();
+  if (!invalid.empty())
+    throw ReconstructionError(invalid);
+  if (parameters.use_normals && !has_normals)
+    throw ReconstructionError("normals were requested but none were given");
+}
+
 } // namespace
 
 Result reconstruct(const PointView &points, const Parameters &parameters) {
@@ -362,16 +345,30 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
   return reconstructShared(points, parameters, initial_triangles, one_process);
 }
 
+Result reconstructPrepared(PreparedPoints &&points, const PreparationCounts &counts,
+                           const Parameters &parameters, BucketExchange &exchange) {
+  const Clock::time_point start = Clock::now();
+  checkParameters(parameters, points.normals.size() == points.positions.size());
+  const Deadline deadline(parameters.time_limit_seconds);
+  Result result;
+  result.input_points = counts.input_points;
+  result.invalid_points = counts.invalid_points;
+  result.duplicate_points = counts.duplicate_points;
+  result.far_points = counts.far_points;
+  result.used_points = points.positions.size();
+  result.peak_memory.prepare = peakResidentBytes();
+  if (points.positions.size() < 3)
+    throw ReconstructionError(tooFewPoints(counts, points.positions.size()));
+  const PreparedPoints prepared = std::move(points);
+  return meshPrepared(prepared, {}, parameters, exchange, deadline, start, std::move(result));
+}
+
 namespace {
 
 Result reconstructShared(const PointView &points, const Parameters &parameters,
                          const std::vector<Triangle> &initial_triangles, BucketExchange &exchange) {
   const Clock::time_point start = Clock::now();
-  const std::string invalid = parameters.validate();
-  if (!invalid.empty())
-    throw ReconstructionError(invalid);
-  if (parameters.use_normals && !points.normals)
-    throw ReconstructionError("normals were requested but none were given");
+  checkParameters(parameters, points.normals != nullptr);
 
   const Deadline deadline(parameters.time_limit_seconds);
   Result result;
@@ -382,7 +379,16 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
   result.timings.prepare = secondsSince(stage);
   result.peak_memory.prepare = peakResidentBytes();
   exchange.pointsPrepared(); // `points` is not read below
+  return meshPrepared(prepared, initial_triangles, parameters, exchange, deadline, start,
+                      std::move(result));
+}
 
+/// Stages 2 to 4 on prepared points, into `result` (which has the
+/// preparation's figures).
+Result meshPrepared(const PreparedPoints &prepared, const std::vector<Triangle> &initial_triangles,
+                    const Parameters &parameters, BucketExchange &exchange,
+                    const Deadline &deadline, Clock::time_point start, Result result) {
+  Clock::time_point stage;
   const bool preferred_mode = parameters.initial_triangles_mode == InitialTrianglesMode::preferred;
   const std::vector<Triangle> fixed = preferred_mode
                                           ? std::vector<Triangle>()

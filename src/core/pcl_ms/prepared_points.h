@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Stage 1's result (docs/algorithm.md section 1), and the preparation of a
+// cloud whose records are spread over processes ("Across processes"): each
+// prepares its part together with the others and ends with its slice of
+// the points in the order one process would give them.
+#pragma once
+
+#include <pcl_ms/buckets.h>
+#include <pcl_ms/process_group.h>
+#include <pcl_ms/types.h>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pcl_ms {
+
+/// The distinct, finite points of the user's records, centred, in Morton
+/// order, and for each the user record it stands for.
+struct PreparedPoints {
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<Eigen::Vector3f> normals; // unit or zero; empty unless asked for
+  std::vector<VertexIndex> user_index;
+  /// Subtracted from the user's coordinates.
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  /// For each user record, its distinct point (duplicates share one), or
+  /// not_prepared for records left out (NaN/Inf, not in the indices). Only
+  /// built when asked for: initial triangles need it.
+  std::vector<VertexIndex> prepared_of_record;
+};
+
+/// What the preparation counted, over the whole cloud.
+struct PreparationCounts {
+  std::size_t input_points = 0, invalid_points = 0, duplicate_points = 0, far_points = 0;
+};
+
+/// Stage 1 in one process: the distinct finite points of `view`, far stray
+/// points left out; fills result's counts. `map_records` builds
+/// prepared_of_record. Throws ReconstructionError for fewer than 3 points.
+PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_records,
+                             Result &result);
+
+/// The error for a cloud with fewer than 3 distinct points, with its counts.
+std::string tooFewPoints(const PreparationCounts &counts, std::size_t distinct);
+
+/// One process's slice of the prepared points: `points` are the distinct
+/// points [first, first + points.positions.size()) of the `total` that one
+/// process preparing the whole cloud would have; centre and counts are the
+/// whole cloud's.
+struct PreparedSlice {
+  PreparedPoints points;
+  std::size_t first = 0, total = 0;
+  PreparationCounts counts;
+};
+
+/// Prepares the records `part` (no indices) whose first is the cloud's
+/// record `first_record`, together with the other processes of `group`,
+/// each with its own consecutive records. Collective. Throws
+/// ReconstructionError, on every process alike, when the cloud has fewer
+/// than 3 distinct finite points or more records than 32-bit indices hold.
+PreparedSlice preparePointsTogether(const PointView &part, std::uint64_t first_record,
+                                    bool with_normals, ProcessGroup &group);
+
+/// reconstruct() from stage 2 on, for points prepared elsewhere (e.g. the
+/// slices of preparePointsTogether, joined in process order). Buckets and
+/// seams are shared through `exchange` as in reconstruct(); initial
+/// triangles are not taken.
+Result reconstructPrepared(PreparedPoints &&points, const PreparationCounts &counts,
+                           const Parameters &parameters, BucketExchange &exchange);
+
+} // namespace pcl_ms

@@ -1,0 +1,205 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Stage 1 with the records spread over processes (threads here): the
+// slices, joined in process order, must be the points one process prepares,
+// bit for bit, however the records are cut, so that everything after them
+// gives the one-process mesh.
+#include "core_test_support.h"
+#include "thread_processes.h"
+
+#include <pcl_ms/buckets.h>
+#include <pcl_ms/prepared_points.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace {
+
+using namespace pcl_ms_test;
+
+/// The bunny with what preparation must handle: NaN and infinite records,
+/// exact duplicates far apart in the record order (so in other parts), a
+/// lone far stray point, a distant group of points (kept), and zeros of
+/// both signs.
+std::vector<float> awkwardBunny() {
+  std::vector<float> xyz = bunnyCoordinates();
+  const std::size_t n = xyz.size() / 3;
+  auto add = [&](float x, float y, float z) {
+    xyz.push_back(x);
+    xyz.push_back(y);
+    xyz.push_back(z);
+  };
+  for (std::size_t i = 0; i < n; i += 997) // duplicates, appended at the end
+    add(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  xyz[3 * 5000] = nan;
+  xyz[3 * 20000 + 2] = inf;
+  add(nan, 0, 0);
+  add(40.0f, -30.0f, 25.0f);  // a lone stray
+  for (int k = 0; k < 4; ++k) // a far group: neighbours of each other, kept
+    add(-50.0f + 0.001f * static_cast<float>(k), 60.0f, 0.0f);
+  add(0.0f, -0.0f, 0.0f);
+  add(-0.0f, 0.0f, -0.0f);
+  return xyz;
+}
+
+/// Normals for `xyz`: mostly unit-ish, some zero, NaN or long.
+std::vector<float> normalsFor(const std::vector<float> &xyz) {
+  std::vector<float> normals(xyz.size());
+  for (std::size_t i = 0; i < xyz.size(); ++i)
+    normals[i] = std::sin(static_cast<float>(i) * 0.37f) * (i % 3 == 0 ? 3.0f : 1.0f);
+  normals[3 * 7] = normals[3 * 7 + 1] = normals[3 * 7 + 2] = 0;
+  normals[3 * 11 + 1] = std::numeric_limits<float>::quiet_NaN();
+  return normals;
+}
+
+/// Record k of `cuts.size() - 1` consecutive parts starts at cuts[k].
+std::vector<std::size_t> cutsFor(std::size_t records, const std::vector<double> &fractions) {
+  std::vector<std::size_t> cuts{0};
+  for (double fraction : fractions)
+    cuts.push_back(static_cast<std::size_t>(fraction * static_cast<double>(records)));
+  cuts.push_back(records);
+  return cuts;
+}
+
+struct Joined {
+  pcl_ms::PreparedPoints points;
+  pcl_ms::PreparationCounts counts;
+};
+
+/// Prepares `xyz` (and normals, if any) cut at `cuts`, one thread per part,
+/// and joins the slices in process order, checking that they are
+/// consecutive and that every process saw the same counts.
+Joined prepareInParts(const std::vector<float> &xyz, const std::vector<float> &normals,
+                      const std::vector<std::size_t> &cuts) {
+  const int processes = static_cast<int>(cuts.size()) - 1;
+  std::vector<pcl_ms::PreparedSlice> slices(processes);
+  onThreadProcesses(processes, [&](pcl_ms::ProcessGroup &group) {
+    const int p = group.process();
+    pcl_ms::PointView part;
+    part.size = cuts[p + 1] - cuts[p];
+    part.xyz = xyz.data() + 3 * cuts[p];
+    if (!normals.empty())
+      part.normals = normals.data() + 3 * cuts[p];
+    slices[p] = pcl_ms::preparePointsTogether(part, cuts[p], !normals.empty(), group);
+  });
+  Joined joined;
+  joined.counts = slices[0].counts;
+  joined.points.centre = slices[0].points.centre;
+  for (const pcl_ms::PreparedSlice &slice : slices) {
+    EXPECT_EQ(slice.first, joined.points.positions.size());
+    EXPECT_EQ(slice.total, slices[0].total);
+    EXPECT_EQ(slice.counts.input_points, joined.counts.input_points);
+    EXPECT_EQ(slice.counts.invalid_points, joined.counts.invalid_points);
+    EXPECT_EQ(slice.counts.duplicate_points, joined.counts.duplicate_points);
+    EXPECT_EQ(slice.counts.far_points, joined.counts.far_points);
+    EXPECT_EQ(slice.points.centre, joined.points.centre);
+    const pcl_ms::PreparedPoints &part = slice.points;
+    auto append = [](auto &to, const auto &from) { to.insert(to.end(), from.begin(), from.end()); };
+    append(joined.points.positions, part.positions);
+    append(joined.points.normals, part.normals);
+    append(joined.points.user_index, part.user_index);
+  }
+  EXPECT_EQ(joined.points.positions.size(), slices[0].total);
+  return joined;
+}
+
+pcl_ms::PointView viewWithNormals(const std::vector<float> &xyz,
+                                  const std::vector<float> &normals) {
+  pcl_ms::PointView view = viewOf(xyz);
+  if (!normals.empty())
+    view.normals = normals.data();
+  return view;
+}
+
+void expectSamePreparation(const std::vector<float> &xyz, const std::vector<float> &normals,
+                           const std::vector<std::vector<double>> &cuttings) {
+  pcl_ms::Result one;
+  const pcl_ms::PreparedPoints expected =
+      pcl_ms::preparePoints(viewWithNormals(xyz, normals), !normals.empty(), false, one);
+  for (const std::vector<double> &fractions : cuttings) {
+    const std::string where = std::to_string(fractions.size() + 1) + " parts";
+    const Joined joined = prepareInParts(xyz, normals, cutsFor(xyz.size() / 3, fractions));
+    EXPECT_EQ(joined.points.centre, expected.centre) << where;
+    EXPECT_EQ(joined.points.user_index, expected.user_index) << where;
+    EXPECT_TRUE(joined.points.positions == expected.positions) << where;
+    EXPECT_TRUE(joined.points.normals == expected.normals) << where;
+    EXPECT_EQ(joined.counts.input_points, one.input_points) << where;
+    EXPECT_EQ(joined.counts.invalid_points, one.invalid_points) << where;
+    EXPECT_EQ(joined.counts.duplicate_points, one.duplicate_points) << where;
+    EXPECT_EQ(joined.counts.far_points, one.far_points) << where;
+  }
+}
+
+// One part; two even ones; three uneven; five with an empty one and a part
+// of a single record.
+const std::vector<std::vector<double>> cuttings = {
+    {}, {0.5}, {0.13, 0.71}, {0.2, 0.2, 0.6, 0.6 + 1e-5}};
+
+TEST(PrepareTogether, SlicesJoinIntoTheOneProcessPoints) {
+  const std::vector<float> xyz = awkwardBunny();
+  pcl_ms::Result one;
+  pcl_ms::preparePoints(viewOf(xyz), false, false, one);
+  // The cloud has what the test is about.
+  ASSERT_EQ(one.invalid_points, 3u);
+  ASSERT_GE(one.duplicate_points, 36u);
+  ASSERT_EQ(one.far_points, 1u);
+  expectSamePreparation(xyz, {}, cuttings);
+}
+
+TEST(PrepareTogether, NormalsTravelWithTheirPoints) {
+  const std::vector<float> xyz = awkwardBunny();
+  expectSamePreparation(xyz, normalsFor(xyz), cuttings);
+}
+
+TEST(PrepareTogether, BucketedMeshIsTheOneProcessMesh) {
+  const std::vector<float> xyz = awkwardBunny();
+  pcl_ms::Parameters parameters;
+  parameters.bucket_points = 4000;
+  const pcl_ms::Result reference = pcl_ms::reconstruct(viewOf(xyz), parameters);
+  ASSERT_GE(reference.bucket_statistics.buckets, 8u);
+  Joined joined = prepareInParts(xyz, {}, cutsFor(xyz.size() / 3, {0.3, 0.55}));
+  pcl_ms::BucketExchange one_process;
+  const pcl_ms::Result result =
+      pcl_ms::reconstructPrepared(std::move(joined.points), joined.counts, parameters, one_process);
+  EXPECT_EQ(result.triangles, reference.triangles);
+  EXPECT_EQ(result.boundary_loops, reference.boundary_loops);
+  EXPECT_EQ(result.d_med, reference.d_med);
+  EXPECT_EQ(result.input_points, reference.input_points);
+  EXPECT_EQ(result.invalid_points, reference.invalid_points);
+  EXPECT_EQ(result.duplicate_points, reference.duplicate_points);
+  EXPECT_EQ(result.far_points, reference.far_points);
+  EXPECT_EQ(result.used_points, reference.used_points);
+}
+
+TEST(PrepareTogether, TooFewPointsFailOnEveryProcessAsInOne) {
+  // Two distinct points, repeated in every part, and NaN records.
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<float> xyz = {0, 0, 0, 1, 2, 3, nan, 0, 0, 0, 0, 0, 1, 2, 3, 0, 0, 0};
+  std::string expected;
+  try {
+    pcl_ms::reconstruct(viewOf(xyz), pcl_ms::Parameters());
+  } catch (const pcl_ms::ReconstructionError &error) {
+    expected = error.what();
+  }
+  ASSERT_NE(expected.find("need at least 3 distinct valid points, got 2"), std::string::npos)
+      << expected;
+  const std::vector<std::size_t> cuts = cutsFor(xyz.size() / 3, {0.34, 0.5});
+  std::vector<std::string> errors(cuts.size() - 1);
+  onThreadProcesses(static_cast<int>(cuts.size()) - 1, [&](pcl_ms::ProcessGroup &group) {
+    const int p = group.process();
+    pcl_ms::PointView part;
+    part.size = cuts[p + 1] - cuts[p];
+    part.xyz = xyz.data() + 3 * cuts[p];
+    try {
+      pcl_ms::preparePointsTogether(part, cuts[p], false, group);
+    } catch (const pcl_ms::ReconstructionError &error) {
+      errors[p] = error.what();
+    }
+  });
+  for (const std::string &error : errors)
+    EXPECT_EQ(error, expected);
+}
+
+} // namespace
