@@ -22,6 +22,7 @@
 #include "reconstruct_cli.h"
 #include "tool_support.h"
 
+#include <pcl_ms/deadline.h>
 #include <pcl_ms/io.h>
 #include <pcl_ms/medial_scaffold_reconstruction.h>
 #include <pcl_ms/prepared_points.h>
@@ -277,16 +278,25 @@ pcl_ms::Result meshPoints(const Job &job, pcl::PointCloud<PointT> &&points,
   }
 }
 
-/// Rank 0: meshes the points the ranks prepared together, the other ranks
-/// meshing the units it hands out.
-pcl_ms::Result meshPrepared(const Job &job, pcl_ms::PreparedPoints &&points,
-                            const pcl_ms::PreparationCounts &counts,
-                            const pcl_ms::Parameters &parameters,
-                            pcl_ms_mpi::MpiUnitFarm &exchange) {
+/// Every rank meshes the prepared slices with the others
+/// (pcl_ms::reconstructSlices: buckets by owner); rank 0 gets the result.
+/// An unusable cloud fails alike on every rank, or on rank 0 alone where it
+/// alone works (one piece, the finishing): the status says so, `error`
+/// why. A failure on one rank while the others wait (the time limit, an
+/// unexpected error) aborts the job.
+int meshSlices(const Job &job, pcl_ms::PreparedSlice &&slice, const pcl_ms::Parameters &parameters,
+               pcl_ms_mpi::MpiProcessGroup &group, pcl_ms::Result &result, std::string &error) {
   try {
-    return pcl_ms::reconstructPrepared(std::move(points), counts, parameters, exchange);
-  } catch (const std::exception &error) {
-    abortJob(job, kReconstructionFailure, std::string("reconstruction failed: ") + error.what());
+    result = pcl_ms::reconstructSlices(std::move(slice), parameters, group);
+    return kSuccess;
+  } catch (const pcl_ms::TimeLimitExceeded &late) {
+    abortJob(job, kReconstructionFailure, std::string("reconstruction failed: ") + late.what());
+  } catch (const pcl_ms::ReconstructionError &unusable) {
+    error = std::string("reconstruction failed: ") + unusable.what();
+    return kReconstructionFailure;
+  } catch (const std::exception &unexpected) {
+    abortJob(job, kReconstructionFailure,
+             std::string("reconstruction failed: ") + unexpected.what());
   }
 }
 
@@ -318,44 +328,6 @@ int prepareParts(const Job &job, CloudPart<PointT> &&part, const pcl_ms::Paramet
     return kSuccess;
   return job.rank == 0 ? fail(kReconstructionFailure, "reconstruction failed: " + error)
                        : kReconstructionFailure;
-}
-
-/// Rank 0 gets every rank's slice of the prepared points, joined in rank
-/// order (the order of one process); the other ranks send theirs and get
-/// nothing.
-pcl_ms::PreparedPoints joinSlicesOnRankZero(const Job &job, pcl_ms::PreparedSlice &&slice,
-                                            bool with_normals) {
-  pcl_ms::PreparedPoints points = std::move(slice.points);
-  std::uint64_t count = points.positions.size();
-  std::vector<std::uint64_t> counts(static_cast<std::size_t>(job.ranks), 0);
-  MPI_Gather(&count, 1, MPI_UINT64_T, counts.data(), 1, MPI_UINT64_T, 0, job.communicator);
-  if (job.rank != 0) {
-    pcl_ms_mpi::sendBytes(points.positions.data(), count * sizeof(Eigen::Vector3d), 0,
-                          job.communicator);
-    pcl_ms_mpi::sendBytes(points.user_index.data(), count * sizeof(pcl_ms::VertexIndex), 0,
-                          job.communicator);
-    pcl_ms_mpi::sendBytes(points.normals.data(), points.normals.size() * sizeof(Eigen::Vector3f), 0,
-                          job.communicator);
-    return {};
-  }
-  // Rank 0's slice comes first; the others follow it in rank order.
-  points.positions.resize(slice.total);
-  points.user_index.resize(slice.total);
-  if (with_normals)
-    points.normals.resize(slice.total);
-  std::size_t first = count;
-  for (int r = 1; r < job.ranks; ++r) {
-    const std::uint64_t theirs = counts[static_cast<std::size_t>(r)];
-    pcl_ms_mpi::receiveBytes(points.positions.data() + first, theirs * sizeof(Eigen::Vector3d), r,
-                             job.communicator);
-    pcl_ms_mpi::receiveBytes(points.user_index.data() + first, theirs * sizeof(pcl_ms::VertexIndex),
-                             r, job.communicator);
-    if (with_normals)
-      pcl_ms_mpi::receiveBytes(points.normals.data() + first, theirs * sizeof(Eigen::Vector3f), r,
-                               job.communicator);
-    first += theirs;
-  }
-  return points;
 }
 
 /// How the input reaches the ranks; rank 0 decides, every rank gets it.
@@ -422,15 +394,8 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
     pcl::fromPCLPointCloud2(cloud, points);
   }
   const double read_mb = peakResidentMegabytes();
-  pcl_ms::PreparedPoints prepared;
-  pcl_ms::PreparationCounts counts;
-  if (slice) {
-    counts = slice->counts;
-    prepared = joinSlicesOnRankZero(job, std::move(*slice), parameters.use_normals);
-    slice.reset();
-  }
 
-  if (!on_rank_zero) {
+  if (!on_rank_zero && !slice) {
     // The other ranks mesh the units rank 0 sends them, one at a time.
     pcl_ms_mpi::ServedUnits served;
     try {
@@ -460,28 +425,42 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
   const auto secondsSinceStart = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  pcl_ms_mpi::MpiUnitFarm exchange(job.communicator, parameters, [&](const std::string &stage) {
-    returnFreeMemory();
-    if (verbose)
-      std::fprintf(stderr, "  all ranks: %s done, %.1f s elapsed\n", stage.c_str(),
-                   secondsSinceStart());
-  });
-  pcl_ms::Result result =
-      !initial.empty() ? meshWithInitialTriangles(job, std::move(points), parameters, initial)
-      : input.in_parts ? meshPrepared(job, std::move(prepared), counts, parameters, exchange)
-                       : meshPoints(job, std::move(points), parameters, exchange);
-  if (input.in_parts && initial.empty()) {
+  pcl_ms::Result result;
+  std::size_t bytes_sent = 0, bytes_received = 0;
+  int status = kSuccess;
+  std::string error;
+  if (slice) {
+    // Every rank meshes the buckets and zones it owns (buckets by owner).
+    pcl_ms_mpi::MpiProcessGroup group(job.communicator);
+    status = meshSlices(job, std::move(*slice), parameters, group, result, error);
+    slice.reset();
     result.timings.prepare = prepare_seconds;
     result.timings.total += prepare_seconds;
+    bytes_sent = group.bytesSent();
+    bytes_received = group.bytesReceived();
+  } else {
+    pcl_ms_mpi::MpiUnitFarm exchange(job.communicator, parameters, [&](const std::string &stage) {
+      returnFreeMemory();
+      if (verbose)
+        std::fprintf(stderr, "  all ranks: %s done, %.1f s elapsed\n", stage.c_str(),
+                     secondsSinceStart());
+    });
+    result = initial.empty()
+                 ? meshPoints(job, std::move(points), parameters, exchange)
+                 : meshWithInitialTriangles(job, std::move(points), parameters, initial);
+    exchange.release(); // the other ranks are done
+    bytes_sent = exchange.bytesSent();
+    bytes_received = exchange.bytesReceived();
   }
-  exchange.release(); // the other ranks are done
   const double reconstruct_seconds = secondsSinceStart();
-  if (verbose) {
+  if (verbose && status == kSuccess) {
     print_info("[done, ");
     print_value("%.1f", reconstruct_seconds * 1e3);
     print_info(" ms : ");
     print_value("%zu", result.triangles.size());
     print_info(" triangles]\n");
+  } else if (verbose) {
+    print_info("[failed]\n");
   }
 
   // Rank 0 writes. A binary PCD or PLY of x y z only, all finite, into a PLY: the
@@ -489,9 +468,7 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
   // never holds the cloud (the same bytes as PCL's writer). Otherwise it
   // loads the file now, after the meshing has freed the points.
   double save_ms = 0;
-  int status = kSuccess;
-  std::string error;
-  if (on_rank_zero) {
+  if (on_rank_zero && status == kSuccess) {
     const bool streamed = input.in_parts && input.layout.xyz_only && read.all_finite &&
                           input.layout.height == 1 &&
                           pcl_ms::fileExtension(options.output) == ".ply";
@@ -540,8 +517,8 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
                    read_mb,
                    result.peak_memory.prepare / 1048576.0,
                    reconstruct_seconds,
-                   static_cast<double>(exchange.bytesSent()) / (1 << 20),
-                   static_cast<double>(exchange.bytesReceived()) / (1 << 20)};
+                   static_cast<double>(bytes_sent) / (1 << 20),
+                   static_cast<double>(bytes_received) / (1 << 20)};
   std::vector<RankFigures> figures(on_rank_zero ? job.ranks : 0);
   MPI_Gather(&mine, sizeof(RankFigures), MPI_BYTE, figures.data(), sizeof(RankFigures), MPI_BYTE, 0,
              job.communicator);

@@ -7,6 +7,7 @@
 #include <pcl_ms/mesh_points.h>
 #include <pcl_ms/reconstruct.h>
 
+#include "bucket_geometry.h"
 #include "median_spacing.h"
 #include "threads.h"
 
@@ -30,41 +31,7 @@ double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// The margin is (rho + this) estimated d_med wide: beyond the seam width,
-// so that the triangles a seam keeps fixed were decided with points around.
-constexpr double margin_context_in_d_med = 6;
-
-// meshBucket's error for a unit of fewer than 3 points.
-const char *const too_few_points = "fewer than 3 points";
-
-// Nearest-neighbour samples per bucket for the spacing estimate.
-constexpr std::size_t spacing_samples_per_bucket = 32;
-
-// Estimated d_med (median circumradius of Gabriel triangles) per median
-// nearest-neighbour distance. The true ratio is 0.88 on the bunny's vertices
-// and 1.6 on uniform random samplings of it; 0.75, below both, makes the
-// margin 8.25 spacings at rho 5, i.e. 5.2 to 9.4 d_med on these two, above the
-// seam width d_max. With it the seams reproduce 99.999 % of the one-piece
-// mesh on 300k points.
-constexpr double d_med_per_spacing = 0.75;
-
-struct Box {
-  Eigen::Vector3d low = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
-  Eigen::Vector3d high = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-
-  bool contains(const Eigen::Vector3d &p) const {
-    return (p.array() >= low.array()).all() && (p.array() <= high.array()).all();
-  }
-  bool intersects(const Box &other) const {
-    return (low.array() <= other.high.array()).all() && (other.low.array() <= high.array()).all();
-  }
-  Box expanded(double width) const {
-    Box box = *this;
-    box.low.array() -= width;
-    box.high.array() += width;
-    return box;
-  }
-};
+using detail::Box;
 
 /// A node of the bucket tree. Leaves are buckets; an inner node's split
 /// plane is the seam between its two subtrees. Leaves are numbered in
@@ -256,7 +223,7 @@ private:
 /// than 2 members.
 double medianSpacing(const std::vector<Eigen::Vector3d> &points,
                      const std::vector<VertexIndex> &members) {
-  return detail::medianSpacing(members.size(), spacing_samples_per_bucket,
+  return detail::medianSpacing(members.size(), detail::spacing_samples_per_bucket,
                                [&](std::size_t i) { return points[members[i]]; });
 }
 
@@ -338,8 +305,7 @@ public:
     const std::vector<double> spacings = bucketSpacings(points_, tree_);
     leaf_margin_.resize(spacings.size());
     for (std::size_t leaf = 0; leaf < spacings.size(); ++leaf)
-      leaf_margin_[leaf] =
-          (parameters_.rho + margin_context_in_d_med) * d_med_per_spacing * spacings[leaf];
+      leaf_margin_[leaf] = detail::bucketMargin(parameters_.rho, spacings[leaf]);
 
     tbb::task_arena arena = detail::threadArena(parameters_.num_threads);
     Clock::time_point stage = Clock::now();
@@ -396,7 +362,7 @@ public:
     }
     if (bucket_d_meds.empty()) {
       // A few points in a fine grid: margins of the spacing reach no others.
-      if (first_error == too_few_points)
+      if (first_error == detail::too_few_unit_points)
         first_error += " with its margin (too many buckets for the cloud: use fewer or none)";
       throw ReconstructionError("no bucket could be meshed" +
                                 (first_error.empty() ? std::string() : ": " + first_error));
@@ -568,10 +534,7 @@ private:
     const double margin = *std::max_element(leaf_margin_.begin() + node.first_leaf,
                                             leaf_margin_.begin() + node.end_leaf);
     auto slabOf = [&](double half_width) {
-      Box slab = node.region.expanded(std::max(margin, half_width));
-      slab.low[node.axis] = std::max(slab.low[node.axis], node.split - half_width);
-      slab.high[node.axis] = std::min(slab.high[node.axis], node.split + half_width);
-      return slab;
+      return detail::zoneSlab(node.region, node.axis, node.split, margin, half_width);
     };
     float largest_scale = 0;
     for (VertexIndex v : tree_.gather(slabOf(margin)))
@@ -711,7 +674,7 @@ BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters,
                          const Deadline *deadline) {
   BucketOutcome outcome;
   if (task.points.size() < 3) {
-    outcome.error = too_few_points;
+    outcome.error = detail::too_few_unit_points;
     return outcome;
   }
   try {

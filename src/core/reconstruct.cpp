@@ -317,7 +317,8 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
 
 Result meshPrepared(const PreparedPoints &prepared, const std::vector<Triangle> &initial_triangles,
                     const Parameters &parameters, BucketExchange &exchange,
-                    const Deadline &deadline, Clock::time_point start, Result result);
+                    const Deadline &deadline, Clock::time_point start, Result result,
+                    BucketedSurface *meshed = nullptr);
 
 /// The checks every entry point makes before any work.
 void checkParameters(const Parameters &parameters, bool has_normals) {
@@ -343,6 +344,52 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
                    const std::vector<Triangle> &initial_triangles) {
   BucketExchange one_process;
   return reconstructShared(points, parameters, initial_triangles, one_process);
+}
+
+Result reconstructSlices(PreparedSlice &&slice, const Parameters &parameters, ProcessGroup &group) {
+  const Clock::time_point start = Clock::now();
+  checkParameters(parameters, true);
+  std::vector<double> missing_normals{
+      parameters.use_normals && slice.points.normals.size() != slice.points.positions.size() ? 1.0
+                                                                                             : 0.0};
+  group.maximum(missing_normals);
+  if (missing_normals[0] > 0)
+    throw ReconstructionError("normals were requested but the points were prepared without");
+  const Deadline deadline(parameters.time_limit_seconds);
+  Result result;
+  result.input_points = slice.counts.input_points;
+  result.invalid_points = slice.counts.invalid_points;
+  result.duplicate_points = slice.counts.duplicate_points;
+  result.far_points = slice.counts.far_points;
+  result.used_points = slice.total;
+  BucketExchange one_process;
+  if (parameters.allow_non_manifold || !usesBuckets(slice.total, parameters)) {
+    // One piece: process 0 meshes it alone, as reconstruct() would.
+    const PreparedPoints joined =
+        joinSlicesAtProcessZero(slice.points, parameters.use_normals, group);
+    slice = PreparedSlice();
+    if (group.process() != 0)
+      return result;
+    result.peak_memory.prepare = peakResidentBytes();
+    return meshPrepared(joined, {}, parameters, one_process, deadline, start, std::move(result));
+  }
+  SharedSurface shared = meshSlicesInBuckets(slice, parameters, &deadline, group);
+  slice = PreparedSlice();
+  returnFreeHeapPages();
+  result.peak_memory.prepare = peakResidentBytes();
+  if (group.process() != 0) {
+    result.d_med = shared.surface.d_med;
+    result.d_max = parameters.rho * shared.surface.d_med;
+    result.bucket_statistics = shared.surface.statistics;
+    result.timings.delaunay = shared.surface.delaunay_seconds;
+    result.timings.scaffold = shared.surface.scaffold_seconds;
+    result.timings.greedy = shared.surface.greedy_seconds;
+    result.timings.total = secondsSince(start);
+    return result;
+  }
+  const PreparedPoints points = std::move(shared.points);
+  return meshPrepared(points, {}, parameters, one_process, deadline, start, std::move(result),
+                      &shared.surface);
 }
 
 Result reconstructPrepared(PreparedPoints &&points, const PreparationCounts &counts,
@@ -384,10 +431,12 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
 }
 
 /// Stages 2 to 4 on prepared points, into `result` (which has the
-/// preparation's figures).
+/// preparation's figures). `meshed`, if given, is their surface in buckets,
+/// meshed elsewhere: only the finishing is left.
 Result meshPrepared(const PreparedPoints &prepared, const std::vector<Triangle> &initial_triangles,
                     const Parameters &parameters, BucketExchange &exchange,
-                    const Deadline &deadline, Clock::time_point start, Result result) {
+                    const Deadline &deadline, Clock::time_point start, Result result,
+                    BucketedSurface *meshed) {
   Clock::time_point stage;
   const bool preferred_mode = parameters.initial_triangles_mode == InitialTrianglesMode::preferred;
   const std::vector<Triangle> fixed = preferred_mode
@@ -404,8 +453,8 @@ Result meshPrepared(const PreparedPoints &prepared, const std::vector<Triangle> 
   std::vector<Triangle> greedy_triangles; // what the finish starts from, with seams
   std::vector<float> local_scale;         // per distinct point
   // Initial triangles and seams are honoured by the one-piece path only.
-  const bool in_buckets = initial_triangles.empty() && !parameters.allow_non_manifold &&
-                          usesBuckets(prepared.positions.size(), parameters);
+  const bool in_buckets = meshed || (initial_triangles.empty() && !parameters.allow_non_manifold &&
+                                     usesBuckets(prepared.positions.size(), parameters));
   // Only process 0 meshes a one-piece cloud and finishes the surface.
   const bool gathers = exchange.process() == 0;
   if (!in_buckets && !gathers)
@@ -413,7 +462,8 @@ Result meshPrepared(const PreparedPoints &prepared, const std::vector<Triangle> 
   if (in_buckets) {
     deadline.check("the preparation");
     BucketedSurface bucketed =
-        meshInBuckets(prepared.positions, normals, parameters, &deadline, &exchange);
+        meshed ? std::move(*meshed)
+               : meshInBuckets(prepared.positions, normals, parameters, &deadline, &exchange);
     returnFreeHeapPages();
     triangles = std::move(bucketed.triangles);
     local_scale = std::move(bucketed.local_scale);

@@ -202,4 +202,122 @@ TEST(PrepareTogether, TooFewPointsFailOnEveryProcessAsInOne) {
     EXPECT_EQ(error, expected);
 }
 
+// ---- buckets by owner: meshSlicesInBuckets through reconstructSlices ---------
+
+/// Each process prepares its part of `xyz` and meshes the slices with the
+/// others; returns every process's result.
+std::vector<pcl_ms::Result> reconstructInParts(const std::vector<float> &xyz,
+                                               const std::vector<float> &normals,
+                                               const std::vector<std::size_t> &cuts,
+                                               const pcl_ms::Parameters &parameters) {
+  const int processes = static_cast<int>(cuts.size()) - 1;
+  std::vector<pcl_ms::Result> results(processes);
+  onThreadProcesses(processes, [&](pcl_ms::ProcessGroup &group) {
+    const int p = group.process();
+    pcl_ms::PointView part;
+    part.size = cuts[p + 1] - cuts[p];
+    part.xyz = xyz.data() + 3 * cuts[p];
+    if (!normals.empty())
+      part.normals = normals.data() + 3 * cuts[p];
+    results[p] = pcl_ms::reconstructSlices(
+        pcl_ms::preparePointsTogether(part, cuts[p], parameters.use_normals, group), parameters,
+        group);
+  });
+  return results;
+}
+
+void expectOneProcessMesh(const std::vector<float> &xyz, const std::vector<float> &normals,
+                          const pcl_ms::Parameters &parameters,
+                          const std::vector<std::vector<double>> &cuttings) {
+  const pcl_ms::Result reference = pcl_ms::reconstruct(viewWithNormals(xyz, normals), parameters);
+  const pcl_ms::BucketStatistics &expected = reference.bucket_statistics;
+  for (const std::vector<double> &fractions : cuttings) {
+    const std::vector<pcl_ms::Result> results =
+        reconstructInParts(xyz, normals, cutsFor(xyz.size() / 3, fractions), parameters);
+    const std::string where = std::to_string(results.size()) + " processes";
+    EXPECT_EQ(results[0].triangles, reference.triangles) << where;
+    EXPECT_EQ(results[0].boundary_loops, reference.boundary_loops) << where;
+    EXPECT_EQ(results[0].triangle_component, reference.triangle_component) << where;
+    EXPECT_EQ(results[0].holes_filled, reference.holes_filled) << where;
+    EXPECT_EQ(results[0].d_med, reference.d_med) << where;
+    for (const pcl_ms::Result &result : results) {
+      // One piece is process 0's alone; the buckets' figures are everyone's.
+      if (expected.buckets > 0) {
+        EXPECT_EQ(result.d_med, reference.d_med) << where;
+      }
+      EXPECT_EQ(result.duplicate_points, reference.duplicate_points) << where;
+      const pcl_ms::BucketStatistics &got = result.bucket_statistics;
+      EXPECT_EQ(got.buckets, expected.buckets) << where;
+      EXPECT_EQ(got.seam_zones, expected.seam_zones) << where;
+      EXPECT_EQ(got.margin_points, expected.margin_points) << where;
+      EXPECT_EQ(got.seam_points, expected.seam_points) << where;
+      EXPECT_EQ(got.seam_triangles, expected.seam_triangles) << where;
+      EXPECT_EQ(got.failed_units, expected.failed_units) << where;
+    }
+    EXPECT_EQ(results[0].bucket_statistics.bow_tie_triangles_removed,
+              expected.bow_tie_triangles_removed);
+    for (std::size_t p = 1; p < results.size(); ++p)
+      EXPECT_TRUE(results[p].triangles.empty()) << "process " << p;
+  }
+}
+
+TEST(BucketsByOwner, MedianSplitsGiveTheOneProcessMesh) {
+  pcl_ms::Parameters parameters;
+  parameters.bucket_points = 4000;
+  // 2 processes; 3 uneven; 5 with an empty one (it owns buckets, no points).
+  expectOneProcessMesh(awkwardBunny(), {}, parameters, {{0.5}, {0.13, 0.71}, {0.2, 0.2, 0.6, 0.9}});
+}
+
+TEST(BucketsByOwner, GridAndNormalsGiveTheOneProcessMesh) {
+  const std::vector<float> xyz = awkwardBunny();
+  pcl_ms::Parameters parameters;
+  parameters.grid_buckets = 3;
+  parameters.use_normals = true;
+  parameters.num_threads = 2;
+  expectOneProcessMesh(xyz, normalsFor(xyz), parameters, {{0.4, 0.45}});
+}
+
+TEST(BucketsByOwner, OnePieceIsMeshedByProcessZero) {
+  const std::vector<float> xyz = fibonacciSphere(2000);
+  expectOneProcessMesh(xyz, {}, pcl_ms::Parameters(), {{0.5}, {0.3, 0.6}});
+}
+
+TEST(BucketsByOwner, FewPointsInAFineGrid) {
+  // One point a bucket: the margins come from the whole cloud's spacing.
+  const std::vector<float> xyz = fibonacciSphere(16);
+  pcl_ms::Parameters parameters;
+  parameters.grid_buckets = pcl_ms::max_grid_buckets;
+  expectOneProcessMesh(xyz, {}, parameters, {{0.5}, {0.25, 0.5, 0.75}});
+}
+
+TEST(BucketsByOwner, NoBucketMeshedFailsOnEveryProcessAsInOne) {
+  const std::vector<float> xyz = {1.05f, 0.05f, 1, 1.05f, 1.05f, 2, 0.05f, 1.05f, 1,
+                                  0,     0,     0, 1,     0,     1, 0,     1,     1};
+  pcl_ms::Parameters parameters;
+  parameters.grid_buckets = 3;
+  std::string expected;
+  try {
+    pcl_ms::reconstruct(viewOf(xyz), parameters);
+  } catch (const pcl_ms::ReconstructionError &error) {
+    expected = error.what();
+  }
+  ASSERT_NE(expected.find("no bucket could be meshed"), std::string::npos) << expected;
+  const std::vector<std::size_t> cuts = cutsFor(6, {0.34, 0.67});
+  std::vector<std::string> errors(3);
+  onThreadProcesses(3, [&](pcl_ms::ProcessGroup &group) {
+    const int p = group.process();
+    pcl_ms::PointView part;
+    part.size = cuts[p + 1] - cuts[p];
+    part.xyz = xyz.data() + 3 * cuts[p];
+    try {
+      pcl_ms::reconstructSlices(pcl_ms::preparePointsTogether(part, cuts[p], false, group),
+                                parameters, group);
+    } catch (const pcl_ms::ReconstructionError &error) {
+      errors[p] = error.what();
+    }
+  });
+  for (const std::string &error : errors)
+    EXPECT_EQ(error, expected);
+}
+
 } // namespace

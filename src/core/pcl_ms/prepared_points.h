@@ -6,6 +6,7 @@
 #pragma once
 
 #include <pcl_ms/buckets.h>
+#include <pcl_ms/deadline.h>
 #include <pcl_ms/process_group.h>
 #include <pcl_ms/types.h>
 
@@ -62,6 +63,33 @@ struct PreparedSlice {
 /// than 3 distinct finite points or more records than 32-bit indices hold.
 PreparedSlice preparePointsTogether(const PointView &part, std::uint64_t first_record,
                                     bool with_normals, ProcessGroup &group);
+
+/// What meshSlicesInBuckets gives process 0: all the points, joined in the
+/// prepared order, and their surface before finishing (as meshInBuckets
+/// gives it). The other processes get the statistics only.
+struct SharedSurface {
+  PreparedPoints points;
+  BucketedSurface surface;
+};
+
+/// Meshes in buckets the points of all processes' slices, each process
+/// meshing the buckets it owns (bucketOwner) and the seam zones whose first
+/// bucket it owns, with the points those need sent to it: no process holds
+/// all the points until process 0 receives them at the end. The same
+/// triangles as meshInBuckets on the joined points. Collective.
+SharedSurface meshSlicesInBuckets(const PreparedSlice &slice, const Parameters &parameters,
+                                  const Deadline *deadline, ProcessGroup &group);
+
+/// Process 0 gets all processes' slices joined in process order (the
+/// prepared order); the others get nothing. Collective.
+PreparedPoints joinSlicesAtProcessZero(const PreparedPoints &slice, bool with_normals,
+                                       ProcessGroup &group);
+
+/// reconstruct() for the slices of preparePointsTogether: a bucketed cloud
+/// is meshed by meshSlicesInBuckets, one piece by process 0 alone; process
+/// 0 finishes the surface and gets the result, the others the preparation's
+/// and the buckets' figures and no triangles. Collective.
+Result reconstructSlices(PreparedSlice &&slice, const Parameters &parameters, ProcessGroup &group);
 
 /// reconstruct() from stage 2 on, for points prepared elsewhere (e.g. the
 /// slices of preparePointsTogether, joined in process order). Buckets and

@@ -1,0 +1,962 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Stage 5 with the points spread over processes (docs/algorithm.md, "Across
+// processes", "Buckets by owner"). In: each process's slice of the prepared
+// points (its "home" points). Out: on process 0, the surface and the points
+// that one process meshing the whole cloud in buckets (buckets.cpp) would
+// have. No process holds the cloud while meshing: the tree is cut with
+// exact selections across the processes, every point goes to the owner of
+// its bucket and of the buckets whose margin it lies in, and each seam
+// zone's owner receives the points of its slab and the corners of the
+// triangles it keeps fixed from their homes.
+#include <pcl_ms/finish.h>
+#include <pcl_ms/prepared_points.h>
+#include <pcl_ms/reconstruct.h>
+
+#include "bucket_geometry.h"
+#include "median_spacing.h"
+#include "threads.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <type_traits>
+#include <unordered_map>
+
+namespace pcl_ms {
+namespace {
+
+using detail::Box;
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// ---- moving plain data between processes -----------------------------------
+
+template <typename Value> std::vector<unsigned char> bytesOf(const std::vector<Value> &values) {
+  static_assert(std::is_trivially_copyable_v<Value>);
+  std::vector<unsigned char> bytes(values.size() * sizeof(Value));
+  if (!values.empty())
+    std::memcpy(bytes.data(), values.data(), bytes.size());
+  return bytes;
+}
+
+template <typename Value> std::vector<Value> valuesOf(const std::vector<unsigned char> &bytes) {
+  static_assert(std::is_trivially_copyable_v<Value>);
+  std::vector<Value> values(bytes.size() / sizeof(Value));
+  if (!values.empty())
+    std::memcpy(values.data(), bytes.data(), values.size() * sizeof(Value));
+  return values;
+}
+
+/// Sends outgoing[p] to process p; returns what all sent here, in process order.
+template <typename Value>
+std::vector<Value> route(std::vector<std::vector<Value>> &outgoing, ProcessGroup &group) {
+  std::vector<std::vector<unsigned char>> bytes(outgoing.size());
+  for (std::size_t p = 0; p < outgoing.size(); ++p) {
+    bytes[p] = bytesOf(outgoing[p]);
+    std::vector<Value>().swap(outgoing[p]);
+  }
+  return valuesOf<Value>(group.exchange(bytes));
+}
+
+std::uint64_t totalOver(std::uint64_t mine, ProcessGroup &group) {
+  std::vector<std::uint64_t> total{mine};
+  group.sum(total);
+  return total[0];
+}
+
+/// A prepared point's data as it travels to process 0.
+struct JoinedPoint {
+  std::array<double, 3> position;
+  std::array<float, 3> normal;
+  VertexIndex record;
+};
+static_assert(sizeof(JoinedPoint) == 40, "travels as bytes, without padding");
+
+/// A point on its way to a process that needs it.
+struct PointRecord {
+  std::array<double, 3> position;
+  std::array<float, 3> normal;
+  float scale;        // its bucket's local scale; 0 until measured
+  VertexIndex index;  // in the whole cloud's prepared order
+  std::uint32_t leaf; // its bucket
+};
+static_assert(sizeof(PointRecord) == 48, "records travel as bytes, without padding");
+
+/// A point with the unit (bucket or zone) that asked for it.
+struct PointFor {
+  PointRecord point;
+  std::uint32_t unit, padding = 0;
+};
+
+struct IndexFor {
+  VertexIndex index;
+  std::uint32_t unit;
+};
+
+struct TriangleFor {
+  Triangle triangle;
+  std::uint32_t node;
+};
+
+// ---- exact selection of a split across processes ----------------------------
+
+/// Orders doubles as integers: negative below positive, -0 as +0 (one
+/// process's comparison finds them equal and breaks the tie by index).
+std::uint64_t orderKey(double value) {
+  if (value == 0)
+    value = 0.0;
+  std::uint64_t bits;
+  std::memcpy(&bits, &value, sizeof bits);
+  return bits & (std::uint64_t{1} << 63) ? ~bits : bits | (std::uint64_t{1} << 63);
+}
+
+/// (coordinate, index) as one process's median split orders points.
+struct SplitKey {
+  std::uint64_t coordinate;
+  VertexIndex index;
+  bool operator<(const SplitKey &other) const {
+    return coordinate < other.coordinate || (coordinate == other.coordinate && index < other.index);
+  }
+};
+
+/// One node of the bucket tree, the same on every process.
+struct Node {
+  Box region;
+  int axis = -1; // -1 for a leaf
+  double split = 0;
+  int children[2] = {-1, -1};
+  int depth = 0;
+  std::uint32_t first_leaf = 0, end_leaf = 0;
+};
+
+/// The points of all processes in buckets and seam zones, by owner.
+class SharedBuckets {
+public:
+  SharedBuckets(const PreparedSlice &slice, const Parameters &parameters, const Deadline *deadline,
+                ProcessGroup &group)
+      : home_(slice.points), first_(slice.first), total_(slice.total), parameters_(parameters),
+        deadline_(deadline), group_(group), home_leaf_(home_.positions.size(), 0),
+        home_scale_(home_.positions.size(), 0.0f), home_pinch_(home_.positions.size(), 0) {
+    const std::vector<std::uint64_t> counts = perProcess(home_.positions.size());
+    home_first_.assign(1, 0);
+    for (std::uint64_t count : counts)
+      home_first_.push_back(home_first_.back() + count);
+  }
+
+  SharedSurface run() {
+    buildTree();
+    meshLeaves();
+    for (int depth = max_depth_; depth >= 0; --depth)
+      stitchLevel(depth);
+    return finish();
+  }
+
+private:
+  // ---- the tree ----------------------------------------------------------------
+
+  std::vector<std::uint64_t> perProcess(std::uint64_t mine) {
+    std::vector<std::uint64_t> values(static_cast<std::size_t>(group_.processes()), 0);
+    values[static_cast<std::size_t>(group_.process())] = mine;
+    group_.sum(values);
+    return values;
+  }
+
+  VertexIndex globalIndex(std::size_t home) const {
+    return static_cast<VertexIndex>(first_ + home);
+  }
+
+  /// The bounding box of all processes' `members`.
+  std::pair<Eigen::Vector3d, Eigen::Vector3d> boundsOf(const std::vector<std::uint32_t> &members) {
+    std::vector<double> low(3, std::numeric_limits<double>::infinity());
+    std::vector<double> high(3, -std::numeric_limits<double>::infinity());
+    for (std::uint32_t i : members)
+      for (int a = 0; a < 3; ++a) {
+        low[a] = std::min(low[a], home_.positions[i][a]);
+        high[a] = std::max(high[a], home_.positions[i][a]);
+      }
+    group_.minimum(low);
+    group_.maximum(high);
+    return {Eigen::Vector3d(low[0], low[1], low[2]), Eigen::Vector3d(high[0], high[1], high[2])};
+  }
+
+  /// The key of rank `rank` among all processes' members on `axis`: a radix
+  /// selection, 8 bits a round, 12 rounds (64-bit coordinate, 32-bit index).
+  SplitKey selectSplit(const std::vector<std::uint32_t> &members, int axis, std::uint64_t rank) {
+    std::vector<SplitKey> candidates;
+    candidates.reserve(members.size());
+    for (std::uint32_t i : members)
+      candidates.push_back({orderKey(home_.positions[i][axis]), globalIndex(i)});
+    SplitKey chosen{0, 0};
+    for (int round = 0; round < 12; ++round) {
+      auto digitOf = [&](const SplitKey &key) {
+        return round < 8 ? static_cast<unsigned>(key.coordinate >> (56 - 8 * round)) & 0xffu
+                         : static_cast<unsigned>(key.index >> (24 - 8 * (round - 8))) & 0xffu;
+      };
+      std::vector<std::uint64_t> histogram(256, 0);
+      for (const SplitKey &key : candidates)
+        ++histogram[digitOf(key)];
+      group_.sum(histogram);
+      unsigned digit = 0;
+      while (digit < 255 && histogram[digit] <= rank)
+        rank -= histogram[digit++];
+      if (round < 8)
+        chosen.coordinate |= static_cast<std::uint64_t>(digit) << (56 - 8 * round);
+      else
+        chosen.index |= static_cast<VertexIndex>(digit) << (24 - 8 * (round - 8));
+      candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
+                                      [&](const SplitKey &key) { return digitOf(key) != digit; }),
+                       candidates.end());
+    }
+    return chosen;
+  }
+
+  int makeLeaf(std::vector<std::uint32_t> &&members, const Box &region, int depth) {
+    Node node;
+    node.region = region;
+    node.depth = depth;
+    nodes_.push_back(node);
+    leaf_members_.push_back(std::move(members));
+    leaf_node_.push_back(static_cast<int>(nodes_.size() - 1));
+    return static_cast<int>(nodes_.size() - 1);
+  }
+
+  int makeInner(const Box &region, int axis, double split, int depth, int left, int right) {
+    if (left < 0 || right < 0) // one side empty: no seam here
+      return left < 0 ? right : left;
+    Node node;
+    node.region = region;
+    node.axis = axis;
+    node.split = split;
+    node.depth = depth;
+    node.children[0] = left;
+    node.children[1] = right;
+    nodes_.push_back(node);
+    return static_cast<int>(nodes_.size() - 1);
+  }
+
+  /// As one process splits (buckets.cpp, BucketTree::buildMedian): at the
+  /// median of the longest side, ties by index.
+  int buildMedian(std::vector<std::uint32_t> &&members, const Box &region, int depth) {
+    const std::uint64_t count = totalOver(members.size(), group_);
+    if (count == 0)
+      return -1;
+    if (count <= bucket_points_)
+      return makeLeaf(std::move(members), region, depth);
+    const auto [low, high] = boundsOf(members);
+    int axis = 0;
+    (high - low).maxCoeff(&axis);
+    const SplitKey middle = selectSplit(members, axis, count / 2);
+    // The split is the middle point's own coordinate (its sign of zero too).
+    std::vector<double> split{std::numeric_limits<double>::infinity()};
+    std::vector<std::uint32_t> left_members, right_members;
+    for (std::uint32_t i : members) {
+      const SplitKey key{orderKey(home_.positions[i][axis]), globalIndex(i)};
+      if (key.index == middle.index && key.coordinate == middle.coordinate)
+        split[0] = home_.positions[i][axis];
+      (key < middle ? left_members : right_members).push_back(i);
+    }
+    std::vector<std::uint32_t>().swap(members);
+    group_.minimum(split);
+    Box left_region = region, right_region = region;
+    left_region.high[axis] = split[0];
+    right_region.low[axis] = split[0];
+    const int left = buildMedian(std::move(left_members), left_region, depth + 1);
+    const int right = buildMedian(std::move(right_members), right_region, depth + 1);
+    return makeInner(region, axis, split[0], depth, left, right);
+  }
+
+  /// As BucketTree::buildGrid: the grid's cell ranges halved, points on the
+  /// side of the plane their coordinate lies on.
+  int buildGrid(std::vector<std::uint32_t> &&members, const Box &region, std::array<int, 3> first,
+                std::array<int, 3> last, int depth) {
+    if (totalOver(members.size(), group_) == 0)
+      return -1;
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+      if (last[a] - first[a] > last[axis] - first[axis])
+        axis = a;
+    if (last[axis] - first[axis] <= 1)
+      return makeLeaf(std::move(members), region, depth);
+    const int middle_cell = (first[axis] + last[axis]) / 2;
+    const double split = grid_low_[axis] + middle_cell * grid_cell_[axis];
+    std::vector<std::uint32_t> left_members, right_members;
+    for (std::uint32_t i : members)
+      (home_.positions[i][axis] < split ? left_members : right_members).push_back(i);
+    std::vector<std::uint32_t>().swap(members);
+    Box left_region = region, right_region = region;
+    left_region.high[axis] = split;
+    right_region.low[axis] = split;
+    std::array<int, 3> left_last = last, right_first = first;
+    left_last[axis] = middle_cell;
+    right_first[axis] = middle_cell;
+    const int left = buildGrid(std::move(left_members), left_region, first, left_last, depth + 1);
+    const int right =
+        buildGrid(std::move(right_members), right_region, right_first, last, depth + 1);
+    return makeInner(region, axis, split, depth, left, right);
+  }
+
+  void buildTree() {
+    std::vector<std::uint32_t> all(home_.positions.size());
+    for (std::size_t i = 0; i < all.size(); ++i)
+      all[i] = static_cast<std::uint32_t>(i);
+    const int grid = parameters_.grid_buckets;
+    if (grid > 0) {
+      const auto [low, high] = boundsOf(all);
+      grid_low_ = low;
+      grid_cell_ = ((high - low) / grid).cwiseMax(Eigen::Vector3d::Constant(1e-300));
+      root_ = buildGrid(std::move(all), Box(), {0, 0, 0}, {grid, grid, grid}, 0);
+    } else {
+      root_ = buildMedian(std::move(all), Box(), 0);
+    }
+    numberLeaves();
+    for (const Node &node : nodes_)
+      if (node.axis >= 0)
+        max_depth_ = std::max(max_depth_, node.depth);
+    statistics_.buckets = leaves_.size();
+    for (const Node &node : nodes_)
+      statistics_.seam_zones += node.axis >= 0;
+  }
+
+  /// Depth-first, as one process numbers them: a subtree's leaves form a range.
+  void numberLeaves() {
+    std::vector<int> leaf_number(nodes_.size(), -1);
+    std::vector<std::pair<int, bool>> stack{{root_, false}};
+    while (!stack.empty()) {
+      auto [current, children_done] = stack.back();
+      stack.pop_back();
+      Node &node = nodes_[static_cast<std::size_t>(current)];
+      if (node.axis < 0) {
+        node.first_leaf = static_cast<std::uint32_t>(leaves_.size());
+        node.end_leaf = node.first_leaf + 1;
+        leaves_.push_back(current);
+      } else if (children_done) {
+        node.first_leaf = nodes_[static_cast<std::size_t>(node.children[0])].first_leaf;
+        node.end_leaf = nodes_[static_cast<std::size_t>(node.children[1])].end_leaf;
+      } else {
+        stack.push_back({current, true});
+        stack.push_back({node.children[1], false});
+        stack.push_back({node.children[0], false});
+      }
+    }
+    for (std::size_t k = 0; k < leaf_node_.size(); ++k) {
+      const std::uint32_t leaf = nodes_[static_cast<std::size_t>(leaf_node_[k])].first_leaf;
+      for (std::uint32_t i : leaf_members_[k])
+        home_leaf_[i] = leaf;
+    }
+    std::vector<std::vector<std::uint32_t>>().swap(leaf_members_);
+  }
+
+  int ownerOf(std::uint32_t leaf) const {
+    return bucketOwner(leaf, leaves_.size(), group_.processes());
+  }
+
+  int homeOf(VertexIndex index) const {
+    return static_cast<int>(std::upper_bound(home_first_.begin(), home_first_.end(), index) -
+                            home_first_.begin()) -
+           1;
+  }
+
+  PointRecord homeRecord(std::size_t i) const {
+    PointRecord record{};
+    for (int a = 0; a < 3; ++a)
+      record.position[a] = home_.positions[i][a];
+    if (!home_.normals.empty())
+      for (int a = 0; a < 3; ++a)
+        record.normal[a] = home_.normals[i][a];
+    record.scale = home_scale_[i];
+    record.index = globalIndex(i);
+    record.leaf = home_leaf_[i];
+    return record;
+  }
+
+  static Eigen::Vector3d positionOf(const PointRecord &record) {
+    return Eigen::Vector3d(record.position[0], record.position[1], record.position[2]);
+  }
+
+  /// A unit's task from its points, ascending by index.
+  BucketTask taskOf(const std::vector<PointRecord> &members) const {
+    BucketTask task;
+    task.points.reserve(members.size());
+    for (const PointRecord &member : members)
+      task.points.push_back(positionOf(member));
+    if (parameters_.use_normals) {
+      task.normals.reserve(members.size());
+      for (const PointRecord &member : members)
+        task.normals.emplace_back(member.normal[0], member.normal[1], member.normal[2]);
+    }
+    return task;
+  }
+
+  // ---- the buckets ---------------------------------------------------------------
+
+  /// Calls visit(leaf) for every leaf whose margin box holds p.
+  template <typename Visit> void leavesReaching(const Eigen::Vector3d &p, const Visit &visit) {
+    std::vector<int> stack{root_};
+    while (!stack.empty()) {
+      const int index = stack.back();
+      stack.pop_back();
+      const Node &node = nodes_[static_cast<std::size_t>(index)];
+      if (!node.region.expanded(subtree_margin_[static_cast<std::size_t>(index)]).contains(p))
+        continue;
+      if (node.axis < 0) {
+        if (node.region.expanded(leaf_margin_[node.first_leaf]).contains(p))
+          visit(node.first_leaf);
+      } else {
+        stack.push_back(node.children[0]);
+        stack.push_back(node.children[1]);
+      }
+    }
+  }
+
+  /// Each bucket's spacing, as bucketSpacings in buckets.cpp.
+  void measureMargins(const std::vector<std::vector<PointRecord>> &own) {
+    std::vector<double> spacings(leaves_.size(), 0.0);
+    for (std::size_t k = 0; k < own.size(); ++k)
+      spacings[own_leaves_[k]] =
+          detail::medianSpacing(own[k].size(), detail::spacing_samples_per_bucket,
+                                [&](std::size_t i) { return positionOf(own[k][i]); });
+    group_.maximum(spacings);
+    double fallback = *std::max_element(spacings.begin(), spacings.end());
+    if (!(fallback > 0)) {
+      // No bucket has two points (a few points in a fine grid): the
+      // cloud's spacing, from all its points (few, then).
+      std::vector<std::array<double, 3>> mine(home_.positions.size());
+      for (std::size_t i = 0; i < mine.size(); ++i)
+        mine[i] = {home_.positions[i][0], home_.positions[i][1], home_.positions[i][2]};
+      const auto all = valuesOf<std::array<double, 3>>(group_.gatherAll(bytesOf(mine)));
+      fallback =
+          detail::medianSpacing(all.size(), detail::spacing_samples_per_bucket, [&](std::size_t i) {
+            return Eigen::Vector3d(all[i][0], all[i][1], all[i][2]);
+          });
+    }
+    leaf_margin_.resize(leaves_.size());
+    for (std::size_t leaf = 0; leaf < leaves_.size(); ++leaf)
+      leaf_margin_[leaf] =
+          detail::bucketMargin(parameters_.rho, spacings[leaf] > 0 ? spacings[leaf] : fallback);
+    subtree_margin_.assign(nodes_.size(), 0.0);
+    for (std::size_t n = 0; n < nodes_.size(); ++n)
+      subtree_margin_[n] = *std::max_element(leaf_margin_.begin() + nodes_[n].first_leaf,
+                                             leaf_margin_.begin() + nodes_[n].end_leaf);
+  }
+
+  void meshLeaves() {
+    const Clock::time_point stage = Clock::now();
+    for (std::uint32_t leaf = 0; leaf < leaves_.size(); ++leaf)
+      if (ownerOf(leaf) == group_.process())
+        own_leaves_.push_back(leaf);
+    // Every point to the owner of its bucket.
+    const auto processes = static_cast<std::size_t>(group_.processes());
+    std::vector<std::vector<PointRecord>> outgoing(processes);
+    for (std::size_t i = 0; i < home_.positions.size(); ++i)
+      outgoing[static_cast<std::size_t>(ownerOf(home_leaf_[i]))].push_back(homeRecord(i));
+    std::vector<std::vector<PointRecord>> own(own_leaves_.size());
+    for (const PointRecord &record : route(outgoing, group_))
+      own[ownSlot(record.leaf)].push_back(record);
+    for (std::vector<PointRecord> &points : own)
+      std::sort(points.begin(), points.end(),
+                [](const PointRecord &a, const PointRecord &b) { return a.index < b.index; });
+    measureMargins(own);
+    // And to the owners of the buckets whose margin it lies in.
+    std::vector<std::vector<PointFor>> margins(processes);
+    for (std::size_t i = 0; i < home_.positions.size(); ++i)
+      leavesReaching(home_.positions[i], [&](std::uint32_t leaf) {
+        if (leaf != home_leaf_[i])
+          margins[static_cast<std::size_t>(ownerOf(leaf))].push_back({homeRecord(i), leaf});
+      });
+    std::vector<std::vector<PointRecord>> members = std::move(own);
+    std::vector<std::size_t> margin_points(members.size(), 0);
+    for (const PointFor &arrived : route(margins, group_)) {
+      members[ownSlot(arrived.unit)].push_back(arrived.point);
+      ++margin_points[ownSlot(arrived.unit)];
+    }
+
+    progress_ = std::make_unique<ProgressCounter>(parameters_, own_leaves_.size() + ownZones());
+    ProgressCounter &progress = *progress_;
+    std::vector<BucketOutcome> outcomes(own_leaves_.size());
+    leaf_triangles_.resize(own_leaves_.size());
+    detail::threadArena(parameters_.num_threads).execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, own_leaves_.size(), 1),
+                        [&](const tbb::blocked_range<std::size_t> &range) {
+                          for (std::size_t k = range.begin(); k != range.end(); ++k) {
+                            std::vector<PointRecord> &points = members[k];
+                            std::sort(points.begin(), points.end(),
+                                      [](const PointRecord &a, const PointRecord &b) {
+                                        return a.index < b.index;
+                                      });
+                            BucketTask task = taskOf(points);
+                            task.core.resize(points.size());
+                            for (std::size_t i = 0; i < points.size(); ++i)
+                              task.core[i] = points[i].leaf == own_leaves_[k];
+                            outcomes[k] = meshBucket(task, parameters_, deadline_);
+                            leaf_triangles_[k] = toGlobal(outcomes[k].triangles, points);
+                            progress.unitDone();
+                          }
+                        });
+    });
+    // Scales and the vertices that may pinch go back to the points' homes.
+    std::vector<std::vector<IndexFor>> scales(processes), pinches(processes);
+    for (std::size_t k = 0; k < own_leaves_.size(); ++k) {
+      const BucketOutcome &outcome = outcomes[k];
+      const std::vector<PointRecord> &points = members[k];
+      if (!outcome.local_scale.empty())
+        for (std::size_t i = 0; i < points.size(); ++i)
+          if (points[i].leaf == own_leaves_[k]) {
+            std::uint32_t bits;
+            std::memcpy(&bits, &outcome.local_scale[i], sizeof bits);
+            scales[static_cast<std::size_t>(homeOf(points[i].index))].push_back(
+                {points[i].index, bits});
+          }
+      for (VertexIndex v : outcome.cut_vertices)
+        pinches[static_cast<std::size_t>(homeOf(points[v].index))].push_back({points[v].index, 0});
+    }
+    for (const IndexFor &scale : route(scales, group_))
+      std::memcpy(&home_scale_[scale.index - first_], &scale.unit, sizeof(float));
+    for (const IndexFor &pinch : route(pinches, group_))
+      home_pinch_[pinch.index - first_] = 1;
+
+    // The buckets' figures: only the owner's entry is non-zero.
+    std::vector<double> d_med(leaves_.size(), 0.0), failed(leaves_.size(), 0.0),
+        margin(leaves_.size(), 0.0);
+    std::uint32_t first_failure = std::numeric_limits<std::uint32_t>::max();
+    std::string first_error;
+    for (std::size_t k = 0; k < own_leaves_.size(); ++k) {
+      const BucketOutcome &outcome = outcomes[k];
+      addTimings(outcome);
+      d_med[own_leaves_[k]] = outcome.error.empty() ? outcome.d_med : 0.0;
+      failed[own_leaves_[k]] = outcome.error.empty() ? 0.0 : 1.0;
+      margin[own_leaves_[k]] = static_cast<double>(margin_points[k]);
+      if (!outcome.error.empty() && first_error.empty()) {
+        first_failure = own_leaves_[k];
+        first_error = outcome.error;
+      }
+    }
+    group_.maximum(d_med);
+    group_.maximum(failed);
+    group_.maximum(margin);
+    std::vector<double> bucket_d_meds;
+    for (std::size_t leaf = 0; leaf < leaves_.size(); ++leaf) {
+      statistics_.margin_points += static_cast<std::size_t>(margin[leaf]);
+      if (failed[leaf] == 0.0)
+        bucket_d_meds.push_back(d_med[leaf]);
+      else
+        ++statistics_.failed_units;
+    }
+    if (bucket_d_meds.empty()) {
+      // Every process throws the error of the first bucket, as one would.
+      std::vector<double> first{static_cast<double>(first_failure)};
+      group_.minimum(first);
+      std::vector<unsigned char> mine;
+      if (first_failure == static_cast<std::uint32_t>(first[0]))
+        mine.assign(first_error.begin(), first_error.end());
+      const std::vector<unsigned char> all = group_.gatherAll(mine);
+      std::string error(all.begin(), all.end());
+      if (error == detail::too_few_unit_points)
+        error += " with its margin (too many buckets for the cloud: use fewer or none)";
+      throw ReconstructionError("no bucket could be meshed" +
+                                (error.empty() ? std::string() : ": " + error));
+    }
+    std::nth_element(bucket_d_meds.begin(), bucket_d_meds.begin() + bucket_d_meds.size() / 2,
+                     bucket_d_meds.end());
+    d_med_ = bucket_d_meds[bucket_d_meds.size() / 2];
+    statistics_.buckets_seconds = secondsSince(stage);
+  }
+
+  std::size_t ownSlot(std::uint32_t leaf) const {
+    return static_cast<std::size_t>(std::lower_bound(own_leaves_.begin(), own_leaves_.end(), leaf) -
+                                    own_leaves_.begin());
+  }
+
+  static std::vector<Triangle> toGlobal(const std::vector<Triangle> &local,
+                                        const std::vector<PointRecord> &members) {
+    std::vector<Triangle> global(local.size());
+    for (std::size_t t = 0; t < local.size(); ++t)
+      for (int k = 0; k < 3; ++k)
+        global[t][k] = members[local[t][k]].index;
+    return global;
+  }
+
+  std::size_t ownZones() const {
+    std::size_t zones = 0;
+    for (const Node &node : nodes_)
+      zones += node.axis >= 0 && ownerOf(node.first_leaf) == group_.process();
+    return zones;
+  }
+
+  void addTimings(const BucketOutcome &outcome) {
+    timings_[0] += outcome.delaunay_seconds;
+    timings_[1] += outcome.scaffold_seconds;
+    timings_[2] += outcome.greedy_seconds;
+  }
+
+  // ---- the seams -----------------------------------------------------------------
+
+  /// Calls progress one at a time from whichever thread finished a unit.
+  class ProgressCounter {
+  public:
+    ProgressCounter(const Parameters &parameters, std::size_t total)
+        : callback_(parameters.progress), total_(total) {}
+    void unitDone() {
+      if (!callback_)
+        return;
+      std::lock_guard<std::mutex> lock(mutex_);
+      callback_(++done_, total_);
+    }
+
+  private:
+    const std::function<void(std::size_t, std::size_t)> &callback_;
+    std::size_t total_;
+    std::size_t done_ = 0;
+    std::mutex mutex_;
+  };
+
+  /// The triangles kept so far in node's subtree, on the node's owner.
+  std::vector<Triangle> &trianglesOf(int node) { return node_triangles_[node]; }
+
+  void stitchLevel(int depth) {
+    const Clock::time_point stage = Clock::now();
+    if (depth == max_depth_) {
+      // The buckets' triangles become their leaves' sets.
+      for (std::size_t k = 0; k < own_leaves_.size(); ++k)
+        node_triangles_[leaves_[own_leaves_[k]]] = std::move(leaf_triangles_[k]);
+      std::vector<std::vector<Triangle>>().swap(leaf_triangles_);
+    }
+    std::vector<int> level;
+    for (std::size_t n = 0; n < nodes_.size(); ++n)
+      if (nodes_[n].axis >= 0 && nodes_[n].depth == depth)
+        level.push_back(static_cast<int>(n));
+    const auto processes = static_cast<std::size_t>(group_.processes());
+    const int me = group_.process();
+    auto zoneOwner = [&](int node) {
+      return ownerOf(nodes_[static_cast<std::size_t>(node)].first_leaf);
+    };
+
+    // The largest local scale near each plane, from every home.
+    std::vector<double> margin(level.size()), largest(level.size(), 0.0);
+    for (std::size_t z = 0; z < level.size(); ++z) {
+      const Node &node = nodes_[static_cast<std::size_t>(level[z])];
+      margin[z] = subtree_margin_[static_cast<std::size_t>(level[z])];
+      const Box slab = detail::zoneSlab(node.region, node.axis, node.split, margin[z], margin[z]);
+      float scale = 0;
+      for (std::size_t i = 0; i < home_.positions.size(); ++i)
+        if (slab.contains(home_.positions[i]))
+          scale = std::max(scale, home_scale_[i]);
+      largest[z] = scale;
+    }
+    group_.maximum(largest);
+
+    // Each zone's points, from their homes, to its owner.
+    std::vector<std::vector<PointFor>> outgoing(processes);
+    for (std::size_t z = 0; z < level.size(); ++z) {
+      const Node &node = nodes_[static_cast<std::size_t>(level[z])];
+      const double half_width = parameters_.rho * static_cast<float>(largest[z]);
+      const Box slab = detail::zoneSlab(node.region, node.axis, node.split, margin[z], half_width);
+      for (std::size_t i = 0; i < home_.positions.size(); ++i)
+        if (slab.contains(home_.positions[i]))
+          outgoing[static_cast<std::size_t>(zoneOwner(level[z]))].push_back(
+              {homeRecord(i), static_cast<std::uint32_t>(z)});
+    }
+    std::vector<std::vector<PointRecord>> zone_points(level.size());
+    for (const PointFor &arrived : route(outgoing, group_))
+      zone_points[arrived.unit].push_back(arrived.point);
+
+    // Each zone's second subtree's triangles to the zone's owner.
+    std::vector<std::vector<TriangleFor>> moving(processes);
+    for (int node : level) {
+      const int second = nodes_[static_cast<std::size_t>(node)].children[1];
+      if (zoneOwner(second) == me && zoneOwner(node) != me) {
+        for (const Triangle &triangle : trianglesOf(second))
+          moving[static_cast<std::size_t>(zoneOwner(node))].push_back(
+              {triangle, static_cast<std::uint32_t>(second)});
+        std::vector<Triangle>().swap(trianglesOf(second));
+      }
+    }
+    for (const TriangleFor &arrived : route(moving, group_))
+      trianglesOf(static_cast<int>(arrived.node)).push_back(arrived.triangle);
+
+    // The fixed triangles' corners outside the zone, from their homes.
+    std::vector<std::vector<VertexIndex>> zone_indices(level.size());
+    std::vector<std::vector<IndexFor>> requests(processes);
+    std::vector<std::vector<Triangle>> fixed(level.size());
+    for (std::size_t z = 0; z < level.size(); ++z) {
+      if (zoneOwner(level[z]) != me)
+        continue;
+      std::vector<PointRecord> &points = zone_points[z];
+      std::sort(points.begin(), points.end(),
+                [](const PointRecord &a, const PointRecord &b) { return a.index < b.index; });
+      for (const PointRecord &point : points)
+        zone_indices[z].push_back(point.index);
+      auto inZone = [&](VertexIndex v) {
+        return std::binary_search(zone_indices[z].begin(), zone_indices[z].end(), v);
+      };
+      std::vector<VertexIndex> frozen;
+      for (int child : nodes_[static_cast<std::size_t>(level[z])].children)
+        for (const Triangle &triangle : trianglesOf(child)) {
+          if (!(inZone(triangle[0]) || inZone(triangle[1]) || inZone(triangle[2])))
+            continue;
+          fixed[z].push_back(triangle);
+          for (VertexIndex v : triangle)
+            if (!inZone(v))
+              frozen.push_back(v);
+        }
+      std::sort(frozen.begin(), frozen.end());
+      frozen.erase(std::unique(frozen.begin(), frozen.end()), frozen.end());
+      for (VertexIndex v : frozen)
+        requests[static_cast<std::size_t>(homeOf(v))].push_back({v, static_cast<std::uint32_t>(z)});
+    }
+    // Answered in the order asked: each home returns a record per request.
+    std::vector<std::vector<IndexFor>> asked(processes);
+    {
+      std::vector<std::vector<unsigned char>> bytes(processes);
+      for (std::size_t p = 0; p < processes; ++p)
+        bytes[p] = bytesOf(requests[p]);
+      // Who asked what: exchange returns requests in process order; sizes
+      // per process follow from perProcess counts.
+      std::vector<std::uint64_t> sent(processes * processes, 0);
+      for (std::size_t p = 0; p < processes; ++p)
+        sent[static_cast<std::size_t>(me) * processes + p] = requests[p].size();
+      group_.sum(sent);
+      const std::vector<IndexFor> all = valuesOf<IndexFor>(group_.exchange(bytes));
+      std::size_t next = 0;
+      for (std::size_t p = 0; p < processes; ++p) {
+        const std::size_t count = sent[p * processes + static_cast<std::size_t>(me)];
+        asked[p].assign(all.begin() + static_cast<std::ptrdiff_t>(next),
+                        all.begin() + static_cast<std::ptrdiff_t>(next + count));
+        next += count;
+      }
+    }
+    std::vector<std::vector<PointFor>> answers(processes);
+    for (std::size_t p = 0; p < processes; ++p)
+      for (const IndexFor &request : asked[p])
+        answers[p].push_back({homeRecord(request.index - first_), request.unit});
+    std::vector<std::vector<PointRecord>> frozen_points(level.size());
+    for (const PointFor &answer : route(answers, group_))
+      frozen_points[answer.unit].push_back(answer.point);
+
+    // The zones this process owns, meshed as one process meshes them.
+    std::vector<std::size_t> mine;
+    for (std::size_t z = 0; z < level.size(); ++z)
+      if (zoneOwner(level[z]) == me)
+        mine.push_back(z);
+    std::vector<BucketOutcome> outcomes(mine.size());
+    std::vector<std::vector<PointRecord>> members(mine.size());
+    std::vector<std::vector<bool>> core(mine.size());
+    std::vector<std::size_t> core_points(mine.size(), 0);
+    detail::threadArena(parameters_.num_threads).execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mine.size(), 1),
+                        [&](const tbb::blocked_range<std::size_t> &range) {
+                          for (std::size_t k = range.begin(); k != range.end(); ++k)
+                            outcomes[k] =
+                                stitch(level[mine[k]], zone_points[mine[k]], frozen_points[mine[k]],
+                                       fixed[mine[k]], members[k], core[k], core_points[k]);
+                        });
+    });
+    std::vector<std::vector<IndexFor>> pinches(processes);
+    for (std::size_t k = 0; k < mine.size(); ++k) {
+      const int node = level[mine[k]];
+      const BucketOutcome &outcome = outcomes[k];
+      addTimings(outcome);
+      std::vector<Triangle> added;
+      if (core_points[k] >= 3) {
+        added = toGlobal(outcome.triangles, members[k]);
+        for (VertexIndex v : outcome.cut_vertices)
+          pinches[static_cast<std::size_t>(homeOf(members[k][v].index))].push_back(
+              {members[k][v].index, 0});
+        for (std::size_t i = 0; i < members[k].size(); ++i)
+          if (core[k][i])
+            pinches[static_cast<std::size_t>(homeOf(members[k][i].index))].push_back(
+                {members[k][i].index, 0});
+        seam_figures_[2] += outcome.error.empty() ? 0.0 : 1.0;
+      }
+      seam_figures_[0] += static_cast<double>(core_points[k]);
+      seam_figures_[1] += static_cast<double>(outcome.triangles.size());
+      // The subtree's triangles, then the seam's, in a fixed order.
+      std::vector<Triangle> &merged = trianglesOf(node);
+      const int *children = nodes_[static_cast<std::size_t>(node)].children;
+      merged.reserve(trianglesOf(children[0]).size() + trianglesOf(children[1]).size() +
+                     added.size());
+      for (int c = 0; c < 2; ++c) {
+        std::vector<Triangle> &part = trianglesOf(children[c]);
+        merged.insert(merged.end(), part.begin(), part.end());
+        std::vector<Triangle>().swap(part);
+      }
+      merged.insert(merged.end(), added.begin(), added.end());
+      progress_->unitDone();
+    }
+    for (const IndexFor &pinch : route(pinches, group_))
+      home_pinch_[pinch.index - first_] = 1;
+    statistics_.seams_seconds += secondsSince(stage);
+    if (deadline_)
+      deadline_->check("the seams");
+  }
+
+  /// One zone (buckets.cpp, planZone and stitch): its points within reach of
+  /// the plane, core when in the node's subtree, and the fixed triangles'
+  /// corners outside it, frozen.
+  BucketOutcome stitch(int node_index, const std::vector<PointRecord> &zone,
+                       std::vector<PointRecord> &frozen, const std::vector<Triangle> &fixed,
+                       std::vector<PointRecord> &members, std::vector<bool> &core,
+                       std::size_t &core_points) const {
+    const Node &node = nodes_[static_cast<std::size_t>(node_index)];
+    auto inSubtree = [&](const PointRecord &point) {
+      return point.leaf >= node.first_leaf && point.leaf < node.end_leaf;
+    };
+    for (const PointRecord &point : zone)
+      core_points += inSubtree(point);
+    BucketOutcome outcome;
+    if (core_points < 3) {
+      outcome.error = "too few points";
+      return outcome;
+    }
+    auto byIndex = [](const PointRecord &a, const PointRecord &b) { return a.index < b.index; };
+    std::sort(frozen.begin(), frozen.end(), byIndex);
+    members.reserve(zone.size() + frozen.size());
+    std::merge(zone.begin(), zone.end(), frozen.begin(), frozen.end(), std::back_inserter(members),
+               byIndex);
+    BucketTask task = taskOf(members);
+    task.d_med = d_med_;
+    task.local_scale.reserve(members.size());
+    for (const PointRecord &member : members)
+      task.local_scale.push_back(member.scale);
+    task.core.resize(members.size());
+    task.frozen.resize(members.size());
+    for (std::size_t i = 0; i < members.size(); ++i) {
+      const bool is_frozen = std::binary_search(frozen.begin(), frozen.end(), members[i], byIndex);
+      task.frozen[i] = is_frozen;
+      task.core[i] = !is_frozen && inSubtree(members[i]);
+    }
+    core = task.core;
+    auto localIndex = [&](VertexIndex v) {
+      return static_cast<VertexIndex>(
+          std::lower_bound(members.begin(), members.end(), v,
+                           [](const PointRecord &a, VertexIndex b) { return a.index < b; }) -
+          members.begin());
+    };
+    task.fixed_triangles.reserve(fixed.size());
+    for (const Triangle &triangle : fixed)
+      task.fixed_triangles.push_back(
+          {localIndex(triangle[0]), localIndex(triangle[1]), localIndex(triangle[2])});
+    return meshBucket(task, parameters_, deadline_);
+  }
+
+  // ---- the end: everything to process 0 --------------------------------------------
+
+  SharedSurface finish() {
+    std::vector<double> figures{seam_figures_[0], seam_figures_[1], seam_figures_[2],
+                                timings_[0],      timings_[1],      timings_[2]};
+    std::vector<std::uint64_t> sums(figures.size());
+    // Counts are whole; seconds are summed in microseconds.
+    for (std::size_t f = 0; f < figures.size(); ++f)
+      sums[f] = static_cast<std::uint64_t>(std::llround(f < 3 ? figures[f] : figures[f] * 1e6));
+    group_.sum(sums);
+    statistics_.seam_points = sums[0];
+    statistics_.seam_triangles = sums[1];
+    statistics_.failed_units += sums[2];
+
+    SharedSurface shared;
+    BucketedSurface &surface = shared.surface;
+    surface.d_med = d_med_;
+    surface.delaunay_seconds = static_cast<double>(sums[3]) * 1e-6;
+    surface.scaffold_seconds = static_cast<double>(sums[4]) * 1e-6;
+    surface.greedy_seconds = static_cast<double>(sums[5]) * 1e-6;
+    surface.statistics = statistics_;
+
+    // The points and what their homes know of them, in the prepared order.
+    struct HomeFigures {
+      float scale;
+      std::uint32_t pinch;
+    };
+    std::vector<std::vector<HomeFigures>> figures_out(static_cast<std::size_t>(group_.processes()));
+    for (std::size_t i = 0; i < home_.positions.size(); ++i)
+      figures_out[0].push_back(
+          {home_scale_[i] > 0 ? home_scale_[i] : static_cast<float>(d_med_), home_pinch_[i]});
+    shared.points = joinSlicesAtProcessZero(home_, parameters_.use_normals, group_);
+    const std::vector<HomeFigures> all = route(figures_out, group_);
+    if (group_.process() != 0)
+      return shared;
+    surface.triangles = std::move(trianglesOf(root_));
+    surface.local_scale.resize(all.size());
+    std::vector<bool> may_pinch(all.size());
+    for (std::size_t v = 0; v < all.size(); ++v) {
+      surface.local_scale[v] = all[v].scale;
+      may_pinch[v] = all[v].pinch != 0;
+    }
+    surface.statistics.bow_tie_triangles_removed =
+        splitBowTies(surface.triangles, all.size(), may_pinch);
+    return shared;
+  }
+
+  const PreparedPoints &home_;
+  const std::size_t first_, total_;
+  const Parameters &parameters_;
+  const Deadline *deadline_;
+  ProcessGroup &group_;
+  const std::size_t bucket_points_ =
+      parameters_.bucket_points > 0 ? parameters_.bucket_points : default_bucket_points;
+  std::vector<std::uint64_t> home_first_; // process p's home points start at home_first_[p]
+  std::vector<std::uint32_t> home_leaf_;
+  std::vector<float> home_scale_;
+  std::vector<std::uint8_t> home_pinch_;
+
+  std::vector<Node> nodes_;
+  std::vector<int> leaves_;    // node of each leaf number
+  std::vector<int> leaf_node_; // while building: node of each leaf made
+  std::vector<std::vector<std::uint32_t>> leaf_members_;
+  int root_ = -1, max_depth_ = 0;
+  Eigen::Vector3d grid_low_ = Eigen::Vector3d::Zero(), grid_cell_ = Eigen::Vector3d::Ones();
+  std::vector<double> leaf_margin_, subtree_margin_;
+
+  std::vector<std::uint32_t> own_leaves_; // ascending
+  std::vector<std::vector<Triangle>> leaf_triangles_;
+  std::unordered_map<int, std::vector<Triangle>> node_triangles_;
+  std::unique_ptr<ProgressCounter> progress_;
+  double d_med_ = 0;
+  BucketStatistics statistics_;
+  double timings_[3] = {0, 0, 0};
+  double seam_figures_[3] = {0, 0, 0};
+};
+
+} // namespace
+
+PreparedPoints joinSlicesAtProcessZero(const PreparedPoints &slice, bool with_normals,
+                                       ProcessGroup &group) {
+  std::vector<std::vector<JoinedPoint>> outgoing(static_cast<std::size_t>(group.processes()));
+  outgoing[0].reserve(slice.positions.size());
+  for (std::size_t i = 0; i < slice.positions.size(); ++i) {
+    JoinedPoint point{};
+    point.position = {slice.positions[i][0], slice.positions[i][1], slice.positions[i][2]};
+    if (with_normals)
+      point.normal = {slice.normals[i][0], slice.normals[i][1], slice.normals[i][2]};
+    point.record = slice.user_index[i];
+    outgoing[0].push_back(point);
+  }
+  const std::vector<JoinedPoint> all = route(outgoing, group);
+  PreparedPoints joined;
+  joined.centre = slice.centre;
+  joined.positions.reserve(all.size());
+  joined.user_index.reserve(all.size());
+  for (const JoinedPoint &point : all) {
+    joined.positions.emplace_back(point.position[0], point.position[1], point.position[2]);
+    joined.user_index.push_back(point.record);
+    if (with_normals)
+      joined.normals.emplace_back(point.normal[0], point.normal[1], point.normal[2]);
+  }
+  return joined;
+}
+
+SharedSurface meshSlicesInBuckets(const PreparedSlice &slice, const Parameters &parameters,
+                                  const Deadline *deadline, ProcessGroup &group) {
+  return SharedBuckets(slice, parameters, deadline, group).run();
+}
+
+} // namespace pcl_ms
