@@ -1,9 +1,14 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // MpiProcessGroup: reductions with MPI_Allreduce; byte exchanges pairwise,
 // in pieces below MPI's int counts, so that a rank may send more than 2 GB.
+// A rank that reaches a collective before the others waits for them asleep:
+// Open MPI's blocking calls spin a core, which the ranks still meshing need
+// when there are more ranks than cores.
 #include "mpi_process_group.h"
 
 #include <algorithm>
+#include <chrono>
+#include <thread>
 
 namespace pcl_ms_mpi {
 namespace {
@@ -11,7 +16,27 @@ namespace {
 constexpr std::size_t max_piece = std::size_t{1} << 30;
 constexpr int exchange_tag = 31;
 
+/// Completes `requests`, sleeping between tests once a short spin has not
+/// done it: the others may be minutes away.
+void waitAsleep(std::vector<MPI_Request> &requests) {
+  const auto start = std::chrono::steady_clock::now();
+  for (;;) {
+    int done = 0;
+    MPI_Testall(static_cast<int>(requests.size()), requests.data(), &done, MPI_STATUSES_IGNORE);
+    if (done)
+      return;
+    if (std::chrono::steady_clock::now() - start > std::chrono::microseconds(200))
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+}
+
 } // namespace
+
+void MpiProcessGroup::arrive() {
+  std::vector<MPI_Request> barrier(1);
+  MPI_Ibarrier(communicator_, barrier.data());
+  waitAsleep(barrier);
+}
 
 MpiProcessGroup::MpiProcessGroup(MPI_Comm communicator) : communicator_(communicator) {
   MPI_Comm_rank(communicator_, &rank_);
@@ -19,6 +44,7 @@ MpiProcessGroup::MpiProcessGroup(MPI_Comm communicator) : communicator_(communic
 }
 
 void MpiProcessGroup::reduce(void *values, std::size_t count, MPI_Datatype type, MPI_Op operation) {
+  arrive();
   char *data = static_cast<char *>(values);
   int type_size = 0;
   MPI_Type_size(type, &type_size);
@@ -47,6 +73,7 @@ std::vector<unsigned char> MpiProcessGroup::gatherAll(const std::vector<unsigned
 
 std::vector<unsigned char>
 MpiProcessGroup::exchange(const std::vector<std::vector<unsigned char>> &outgoing) {
+  arrive();
   // Sizes first, so that each rank knows where every sender's bytes go.
   std::vector<std::uint64_t> sending(static_cast<std::size_t>(size_)), receiving(sending.size());
   for (std::size_t p = 0; p < sending.size(); ++p)
@@ -76,7 +103,7 @@ MpiProcessGroup::exchange(const std::vector<std::vector<unsigned char>> &outgoin
       MPI_Isend(bytes.data() + begin, static_cast<int>(std::min(max_piece, bytes.size() - begin)),
                 MPI_BYTE, to, exchange_tag, communicator_, &requests.back());
     }
-    MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+    waitAsleep(requests);
     bytes_sent_ += bytes.size();
     bytes_received_ += expected;
   }

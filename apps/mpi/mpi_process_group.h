@@ -31,6 +31,8 @@ public:
   std::size_t bytesReceived() const { return bytes_received_; }
 
 private:
+  /// Returns once every rank has reached this point, without spinning.
+  void arrive();
   void reduce(void *values, std::size_t count, MPI_Datatype type, MPI_Op operation);
 
   MPI_Comm communicator_;

@@ -392,24 +392,6 @@ Result reconstructSlices(PreparedSlice &&slice, const Parameters &parameters, Pr
                       &shared.surface);
 }
 
-Result reconstructPrepared(PreparedPoints &&points, const PreparationCounts &counts,
-                           const Parameters &parameters, BucketExchange &exchange) {
-  const Clock::time_point start = Clock::now();
-  checkParameters(parameters, points.normals.size() == points.positions.size());
-  const Deadline deadline(parameters.time_limit_seconds);
-  Result result;
-  result.input_points = counts.input_points;
-  result.invalid_points = counts.invalid_points;
-  result.duplicate_points = counts.duplicate_points;
-  result.far_points = counts.far_points;
-  result.used_points = points.positions.size();
-  result.peak_memory.prepare = peakResidentBytes();
-  if (points.positions.size() < 3)
-    throw ReconstructionError(tooFewPoints(counts, points.positions.size()));
-  const PreparedPoints prepared = std::move(points);
-  return meshPrepared(prepared, {}, parameters, exchange, deadline, start, std::move(result));
-}
-
 namespace {
 
 Result reconstructShared(const PointView &points, const Parameters &parameters,

@@ -58,15 +58,68 @@ template <typename Value> std::vector<Value> valuesOf(const std::vector<unsigned
   return values;
 }
 
-/// Sends outgoing[p] to process p; returns what all sent here, in process order.
-template <typename Value>
-std::vector<Value> route(std::vector<std::vector<Value>> &outgoing, ProcessGroup &group) {
+/// Sends outgoing[p] to process p (and empties it); calls take(value) for
+/// every value sent here, in process order. The values are read straight
+/// from the bytes received: no second copy of them is held.
+template <typename Value, typename Take>
+void deliver(std::vector<std::vector<Value>> &outgoing, ProcessGroup &group, const Take &take) {
   std::vector<std::vector<unsigned char>> bytes(outgoing.size());
   for (std::size_t p = 0; p < outgoing.size(); ++p) {
     bytes[p] = bytesOf(outgoing[p]);
     std::vector<Value>().swap(outgoing[p]);
   }
-  return valuesOf<Value>(group.exchange(bytes));
+  const std::vector<unsigned char> received = group.exchange(bytes);
+  bytes.clear();
+  for (std::size_t at = 0; at + sizeof(Value) <= received.size(); at += sizeof(Value)) {
+    Value value;
+    std::memcpy(&value, received.data() + at, sizeof value);
+    take(value);
+  }
+}
+
+/// Each process's count, in process order, on every process.
+std::vector<std::uint64_t> countsOf(std::uint64_t mine, ProcessGroup &group) {
+  std::vector<std::uint64_t> counts(static_cast<std::size_t>(group.processes()), 0);
+  counts[static_cast<std::size_t>(group.process())] = mine;
+  group.sum(counts);
+  return counts;
+}
+
+/// Process 0 gets every process's `count` values (make(i) gives value i):
+/// take(position, value) with the value's position in the processes'
+/// order. Sent in rounds of at most a million values a process, so that
+/// neither side holds all the bytes at once.
+template <typename Value, typename Make, typename Take>
+void gatherAtZero(std::size_t count, const Make &make, const Take &take, ProcessGroup &group) {
+  constexpr std::size_t chunk = std::size_t{1} << 20;
+  const std::vector<std::uint64_t> counts = countsOf(count, group);
+  std::vector<std::uint64_t> firsts(counts.size(), 0);
+  std::uint64_t rounds = 0;
+  for (std::size_t p = 0; p < counts.size(); ++p) {
+    firsts[p] = p == 0 ? 0 : firsts[p - 1] + counts[p - 1];
+    rounds = std::max<std::uint64_t>(rounds, (counts[p] + chunk - 1) / chunk);
+  }
+  for (std::uint64_t round = 0; round < rounds; ++round) {
+    std::vector<std::vector<unsigned char>> outgoing(counts.size());
+    const std::size_t begin = std::min<std::size_t>(count, round * chunk);
+    const std::size_t end = std::min<std::size_t>(count, begin + chunk);
+    outgoing[0].resize((end - begin) * sizeof(Value));
+    for (std::size_t i = begin; i < end; ++i) {
+      const Value value = make(i);
+      std::memcpy(outgoing[0].data() + (i - begin) * sizeof(Value), &value, sizeof value);
+    }
+    const std::vector<unsigned char> received = group.exchange(outgoing);
+    std::size_t at = 0;
+    for (std::size_t p = 0; p < counts.size() && group.process() == 0; ++p) {
+      const std::uint64_t from = std::min<std::uint64_t>(counts[p], round * chunk);
+      const std::uint64_t to = std::min<std::uint64_t>(counts[p], from + chunk);
+      for (std::uint64_t i = from; i < to; ++i, at += sizeof(Value)) {
+        Value value;
+        std::memcpy(&value, received.data() + at, sizeof value);
+        take(static_cast<std::size_t>(firsts[p] + i), value);
+      }
+    }
+  }
 }
 
 std::uint64_t totalOver(std::uint64_t mine, ProcessGroup &group) {
@@ -148,7 +201,7 @@ public:
       : home_(slice.points), first_(slice.first), total_(slice.total), parameters_(parameters),
         deadline_(deadline), group_(group), home_leaf_(home_.positions.size(), 0),
         home_scale_(home_.positions.size(), 0.0f), home_pinch_(home_.positions.size(), 0) {
-    const std::vector<std::uint64_t> counts = perProcess(home_.positions.size());
+    const std::vector<std::uint64_t> counts = countsOf(home_.positions.size(), group_);
     home_first_.assign(1, 0);
     for (std::uint64_t count : counts)
       home_first_.push_back(home_first_.back() + count);
@@ -164,13 +217,6 @@ public:
 
 private:
   // ---- the tree ----------------------------------------------------------------
-
-  std::vector<std::uint64_t> perProcess(std::uint64_t mine) {
-    std::vector<std::uint64_t> values(static_cast<std::size_t>(group_.processes()), 0);
-    values[static_cast<std::size_t>(group_.process())] = mine;
-    group_.sum(values);
-    return values;
-  }
 
   VertexIndex globalIndex(std::size_t home) const {
     return static_cast<VertexIndex>(first_ + home);
@@ -461,8 +507,8 @@ private:
     for (std::size_t i = 0; i < home_.positions.size(); ++i)
       outgoing[static_cast<std::size_t>(ownerOf(home_leaf_[i]))].push_back(homeRecord(i));
     std::vector<std::vector<PointRecord>> own(own_leaves_.size());
-    for (const PointRecord &record : route(outgoing, group_))
-      own[ownSlot(record.leaf)].push_back(record);
+    deliver(outgoing, group_,
+            [&](const PointRecord &record) { own[ownSlot(record.leaf)].push_back(record); });
     for (std::vector<PointRecord> &points : own)
       std::sort(points.begin(), points.end(),
                 [](const PointRecord &a, const PointRecord &b) { return a.index < b.index; });
@@ -476,15 +522,19 @@ private:
       });
     std::vector<std::vector<PointRecord>> members = std::move(own);
     std::vector<std::size_t> margin_points(members.size(), 0);
-    for (const PointFor &arrived : route(margins, group_)) {
+    deliver(margins, group_, [&](const PointFor &arrived) {
       members[ownSlot(arrived.unit)].push_back(arrived.point);
       ++margin_points[ownSlot(arrived.unit)];
-    }
+    });
 
     progress_ = std::make_unique<ProgressCounter>(parameters_, own_leaves_.size() + ownZones());
     ProgressCounter &progress = *progress_;
     std::vector<BucketOutcome> outcomes(own_leaves_.size());
     leaf_triangles_.resize(own_leaves_.size());
+    // Per bucket: its core points' scales and the vertices that may pinch,
+    // to go back to the points' homes.
+    std::vector<std::vector<IndexFor>> scales_of(own_leaves_.size()),
+        pinches_of(own_leaves_.size());
     detail::threadArena(parameters_.num_threads).execute([&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, own_leaves_.size(), 1),
                         [&](const tbb::blocked_range<std::size_t> &range) {
@@ -498,32 +548,41 @@ private:
                             task.core.resize(points.size());
                             for (std::size_t i = 0; i < points.size(); ++i)
                               task.core[i] = points[i].leaf == own_leaves_[k];
-                            outcomes[k] = meshBucket(task, parameters_, deadline_);
-                            leaf_triangles_[k] = toGlobal(outcomes[k].triangles, points);
+                            BucketOutcome &outcome = outcomes[k];
+                            outcome = meshBucket(task, parameters_, deadline_);
+                            task = BucketTask();
+                            leaf_triangles_[k] = toGlobal(outcome.triangles, points);
+                            if (!outcome.local_scale.empty())
+                              for (std::size_t i = 0; i < points.size(); ++i)
+                                if (points[i].leaf == own_leaves_[k]) {
+                                  std::uint32_t bits;
+                                  std::memcpy(&bits, &outcome.local_scale[i], sizeof bits);
+                                  scales_of[k].push_back({points[i].index, bits});
+                                }
+                            for (VertexIndex v : outcome.cut_vertices)
+                              pinches_of[k].push_back({points[v].index, 0});
+                            // Only the figures stay: the bucket's points and arrays go.
+                            std::vector<PointRecord>().swap(points);
+                            outcome.triangles = {};
+                            outcome.local_scale = {};
+                            outcome.cut_vertices = {};
                             progress.unitDone();
                           }
                         });
     });
-    // Scales and the vertices that may pinch go back to the points' homes.
     std::vector<std::vector<IndexFor>> scales(processes), pinches(processes);
     for (std::size_t k = 0; k < own_leaves_.size(); ++k) {
-      const BucketOutcome &outcome = outcomes[k];
-      const std::vector<PointRecord> &points = members[k];
-      if (!outcome.local_scale.empty())
-        for (std::size_t i = 0; i < points.size(); ++i)
-          if (points[i].leaf == own_leaves_[k]) {
-            std::uint32_t bits;
-            std::memcpy(&bits, &outcome.local_scale[i], sizeof bits);
-            scales[static_cast<std::size_t>(homeOf(points[i].index))].push_back(
-                {points[i].index, bits});
-          }
-      for (VertexIndex v : outcome.cut_vertices)
-        pinches[static_cast<std::size_t>(homeOf(points[v].index))].push_back({points[v].index, 0});
+      for (const IndexFor &scale : scales_of[k])
+        scales[static_cast<std::size_t>(homeOf(scale.index))].push_back(scale);
+      for (const IndexFor &pinch : pinches_of[k])
+        pinches[static_cast<std::size_t>(homeOf(pinch.index))].push_back(pinch);
+      std::vector<IndexFor>().swap(scales_of[k]);
+      std::vector<IndexFor>().swap(pinches_of[k]);
     }
-    for (const IndexFor &scale : route(scales, group_))
+    deliver(scales, group_, [&](const IndexFor &scale) {
       std::memcpy(&home_scale_[scale.index - first_], &scale.unit, sizeof(float));
-    for (const IndexFor &pinch : route(pinches, group_))
-      home_pinch_[pinch.index - first_] = 1;
+    });
+    deliver(pinches, group_, [&](const IndexFor &pinch) { home_pinch_[pinch.index - first_] = 1; });
 
     // The buckets' figures: only the owner's entry is non-zero.
     std::vector<double> d_med(leaves_.size(), 0.0), failed(leaves_.size(), 0.0),
@@ -620,6 +679,28 @@ private:
     std::mutex mutex_;
   };
 
+  /// Calls visit(i) for every home point i inside `box`. Home points are in
+  /// Morton order, so runs of them are compact: runs whose bounding box
+  /// misses `box` are skipped whole.
+  template <typename Visit> void forEachHomeIn(const Box &box, const Visit &visit) {
+    constexpr std::size_t run = 256;
+    if (run_boxes_.empty())
+      for (std::size_t begin = 0; begin < home_.positions.size(); begin += run) {
+        Box bounds;
+        bounds.low = bounds.high = home_.positions[begin];
+        for (std::size_t i = begin; i < std::min(home_.positions.size(), begin + run); ++i) {
+          bounds.low = bounds.low.cwiseMin(home_.positions[i]);
+          bounds.high = bounds.high.cwiseMax(home_.positions[i]);
+        }
+        run_boxes_.push_back(bounds);
+      }
+    for (std::size_t r = 0; r < run_boxes_.size(); ++r)
+      if (run_boxes_[r].intersects(box))
+        for (std::size_t i = r * run; i < std::min(home_.positions.size(), (r + 1) * run); ++i)
+          if (box.contains(home_.positions[i]))
+            visit(i);
+  }
+
   /// The triangles kept so far in node's subtree, on the node's owner.
   std::vector<Triangle> &trianglesOf(int node) { return node_triangles_[node]; }
 
@@ -648,9 +729,7 @@ private:
       margin[z] = subtree_margin_[static_cast<std::size_t>(level[z])];
       const Box slab = detail::zoneSlab(node.region, node.axis, node.split, margin[z], margin[z]);
       float scale = 0;
-      for (std::size_t i = 0; i < home_.positions.size(); ++i)
-        if (slab.contains(home_.positions[i]))
-          scale = std::max(scale, home_scale_[i]);
+      forEachHomeIn(slab, [&](std::size_t i) { scale = std::max(scale, home_scale_[i]); });
       largest[z] = scale;
     }
     group_.maximum(largest);
@@ -661,14 +740,14 @@ private:
       const Node &node = nodes_[static_cast<std::size_t>(level[z])];
       const double half_width = parameters_.rho * static_cast<float>(largest[z]);
       const Box slab = detail::zoneSlab(node.region, node.axis, node.split, margin[z], half_width);
-      for (std::size_t i = 0; i < home_.positions.size(); ++i)
-        if (slab.contains(home_.positions[i]))
-          outgoing[static_cast<std::size_t>(zoneOwner(level[z]))].push_back(
-              {homeRecord(i), static_cast<std::uint32_t>(z)});
+      forEachHomeIn(slab, [&](std::size_t i) {
+        outgoing[static_cast<std::size_t>(zoneOwner(level[z]))].push_back(
+            {homeRecord(i), static_cast<std::uint32_t>(z)});
+      });
     }
     std::vector<std::vector<PointRecord>> zone_points(level.size());
-    for (const PointFor &arrived : route(outgoing, group_))
-      zone_points[arrived.unit].push_back(arrived.point);
+    deliver(outgoing, group_,
+            [&](const PointFor &arrived) { zone_points[arrived.unit].push_back(arrived.point); });
 
     // Each zone's second subtree's triangles to the zone's owner.
     std::vector<std::vector<TriangleFor>> moving(processes);
@@ -681,8 +760,9 @@ private:
         std::vector<Triangle>().swap(trianglesOf(second));
       }
     }
-    for (const TriangleFor &arrived : route(moving, group_))
+    deliver(moving, group_, [&](const TriangleFor &arrived) {
       trianglesOf(static_cast<int>(arrived.node)).push_back(arrived.triangle);
+    });
 
     // The fixed triangles' corners outside the zone, from their homes.
     std::vector<std::vector<VertexIndex>> zone_indices(level.size());
@@ -721,7 +801,7 @@ private:
       for (std::size_t p = 0; p < processes; ++p)
         bytes[p] = bytesOf(requests[p]);
       // Who asked what: exchange returns requests in process order; sizes
-      // per process follow from perProcess counts.
+      // per process follow from the counts every process sent everyone.
       std::vector<std::uint64_t> sent(processes * processes, 0);
       for (std::size_t p = 0; p < processes; ++p)
         sent[static_cast<std::size_t>(me) * processes + p] = requests[p].size();
@@ -740,8 +820,8 @@ private:
       for (const IndexFor &request : asked[p])
         answers[p].push_back({homeRecord(request.index - first_), request.unit});
     std::vector<std::vector<PointRecord>> frozen_points(level.size());
-    for (const PointFor &answer : route(answers, group_))
-      frozen_points[answer.unit].push_back(answer.point);
+    deliver(answers, group_,
+            [&](const PointFor &answer) { frozen_points[answer.unit].push_back(answer.point); });
 
     // The zones this process owns, meshed as one process meshes them.
     std::vector<std::size_t> mine;
@@ -793,8 +873,7 @@ private:
       merged.insert(merged.end(), added.begin(), added.end());
       progress_->unitDone();
     }
-    for (const IndexFor &pinch : route(pinches, group_))
-      home_pinch_[pinch.index - first_] = 1;
+    deliver(pinches, group_, [&](const IndexFor &pinch) { home_pinch_[pinch.index - first_] = 1; });
     statistics_.seams_seconds += secondsSince(stage);
     if (deadline_)
       deadline_->check("the seams");
@@ -876,23 +955,28 @@ private:
       float scale;
       std::uint32_t pinch;
     };
-    std::vector<std::vector<HomeFigures>> figures_out(static_cast<std::size_t>(group_.processes()));
-    for (std::size_t i = 0; i < home_.positions.size(); ++i)
-      figures_out[0].push_back(
-          {home_scale_[i] > 0 ? home_scale_[i] : static_cast<float>(d_med_), home_pinch_[i]});
     shared.points = joinSlicesAtProcessZero(home_, parameters_.use_normals, group_);
-    const std::vector<HomeFigures> all = route(figures_out, group_);
+    std::vector<bool> may_pinch;
+    if (group_.process() == 0) {
+      surface.local_scale.resize(total_);
+      may_pinch.resize(total_);
+    }
+    gatherAtZero<HomeFigures>(
+        home_.positions.size(),
+        [&](std::size_t i) {
+          return HomeFigures{home_scale_[i] > 0 ? home_scale_[i] : static_cast<float>(d_med_),
+                             home_pinch_[i]};
+        },
+        [&](std::size_t v, const HomeFigures &figures) {
+          surface.local_scale[v] = figures.scale;
+          may_pinch[v] = figures.pinch != 0;
+        },
+        group_);
     if (group_.process() != 0)
       return shared;
     surface.triangles = std::move(trianglesOf(root_));
-    surface.local_scale.resize(all.size());
-    std::vector<bool> may_pinch(all.size());
-    for (std::size_t v = 0; v < all.size(); ++v) {
-      surface.local_scale[v] = all[v].scale;
-      may_pinch[v] = all[v].pinch != 0;
-    }
     surface.statistics.bow_tie_triangles_removed =
-        splitBowTies(surface.triangles, all.size(), may_pinch);
+        splitBowTies(surface.triangles, total_, may_pinch);
     return shared;
   }
 
@@ -915,6 +999,7 @@ private:
   int root_ = -1, max_depth_ = 0;
   Eigen::Vector3d grid_low_ = Eigen::Vector3d::Zero(), grid_cell_ = Eigen::Vector3d::Ones();
   std::vector<double> leaf_margin_, subtree_margin_;
+  std::vector<Box> run_boxes_; // of runs of home points (forEachHomeIn)
 
   std::vector<std::uint32_t> own_leaves_; // ascending
   std::vector<std::vector<Triangle>> leaf_triangles_;
@@ -930,27 +1015,33 @@ private:
 
 PreparedPoints joinSlicesAtProcessZero(const PreparedPoints &slice, bool with_normals,
                                        ProcessGroup &group) {
-  std::vector<std::vector<JoinedPoint>> outgoing(static_cast<std::size_t>(group.processes()));
-  outgoing[0].reserve(slice.positions.size());
-  for (std::size_t i = 0; i < slice.positions.size(); ++i) {
-    JoinedPoint point{};
-    point.position = {slice.positions[i][0], slice.positions[i][1], slice.positions[i][2]};
-    if (with_normals)
-      point.normal = {slice.normals[i][0], slice.normals[i][1], slice.normals[i][2]};
-    point.record = slice.user_index[i];
-    outgoing[0].push_back(point);
-  }
-  const std::vector<JoinedPoint> all = route(outgoing, group);
+  const std::uint64_t total = totalOver(slice.positions.size(), group);
   PreparedPoints joined;
   joined.centre = slice.centre;
-  joined.positions.reserve(all.size());
-  joined.user_index.reserve(all.size());
-  for (const JoinedPoint &point : all) {
-    joined.positions.emplace_back(point.position[0], point.position[1], point.position[2]);
-    joined.user_index.push_back(point.record);
+  if (group.process() == 0) {
+    joined.positions.resize(total);
+    joined.user_index.resize(total);
     if (with_normals)
-      joined.normals.emplace_back(point.normal[0], point.normal[1], point.normal[2]);
+      joined.normals.resize(total);
   }
+  gatherAtZero<JoinedPoint>(
+      slice.positions.size(),
+      [&](std::size_t i) {
+        JoinedPoint point{};
+        point.position = {slice.positions[i][0], slice.positions[i][1], slice.positions[i][2]};
+        if (with_normals)
+          point.normal = {slice.normals[i][0], slice.normals[i][1], slice.normals[i][2]};
+        point.record = slice.user_index[i];
+        return point;
+      },
+      [&](std::size_t v, const JoinedPoint &point) {
+        joined.positions[v] =
+            Eigen::Vector3d(point.position[0], point.position[1], point.position[2]);
+        joined.user_index[v] = point.record;
+        if (with_normals)
+          joined.normals[v] = Eigen::Vector3f(point.normal[0], point.normal[1], point.normal[2]);
+      },
+      group);
   return joined;
 }
 

@@ -153,26 +153,6 @@ TEST(PrepareTogether, NormalsTravelWithTheirPoints) {
   expectSamePreparation(xyz, normalsFor(xyz), cuttings);
 }
 
-TEST(PrepareTogether, BucketedMeshIsTheOneProcessMesh) {
-  const std::vector<float> xyz = awkwardBunny();
-  pcl_ms::Parameters parameters;
-  parameters.bucket_points = 4000;
-  const pcl_ms::Result reference = pcl_ms::reconstruct(viewOf(xyz), parameters);
-  ASSERT_GE(reference.bucket_statistics.buckets, 8u);
-  Joined joined = prepareInParts(xyz, {}, cutsFor(xyz.size() / 3, {0.3, 0.55}));
-  pcl_ms::BucketExchange one_process;
-  const pcl_ms::Result result =
-      pcl_ms::reconstructPrepared(std::move(joined.points), joined.counts, parameters, one_process);
-  EXPECT_EQ(result.triangles, reference.triangles);
-  EXPECT_EQ(result.boundary_loops, reference.boundary_loops);
-  EXPECT_EQ(result.d_med, reference.d_med);
-  EXPECT_EQ(result.input_points, reference.input_points);
-  EXPECT_EQ(result.invalid_points, reference.invalid_points);
-  EXPECT_EQ(result.duplicate_points, reference.duplicate_points);
-  EXPECT_EQ(result.far_points, reference.far_points);
-  EXPECT_EQ(result.used_points, reference.used_points);
-}
-
 TEST(PrepareTogether, TooFewPointsFailOnEveryProcessAsInOne) {
   // Two distinct points, repeated in every part, and NaN records.
   const float nan = std::numeric_limits<float>::quiet_NaN();

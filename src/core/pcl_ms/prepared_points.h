@@ -91,11 +91,4 @@ PreparedPoints joinSlicesAtProcessZero(const PreparedPoints &slice, bool with_no
 /// and the buckets' figures and no triangles. Collective.
 Result reconstructSlices(PreparedSlice &&slice, const Parameters &parameters, ProcessGroup &group);
 
-/// reconstruct() from stage 2 on, for points prepared elsewhere (e.g. the
-/// slices of preparePointsTogether, joined in process order). Buckets and
-/// seams are shared through `exchange` as in reconstruct(); initial
-/// triangles are not taken.
-Result reconstructPrepared(PreparedPoints &&points, const PreparationCounts &counts,
-                           const Parameters &parameters, BucketExchange &exchange);
-
 } // namespace pcl_ms
