@@ -17,26 +17,27 @@ namespace {
 
 using namespace pcl_ms_test;
 
+/// pcl_ms::BucketExchange over the threads' ThreadGroup.
 class ThreadExchange : public pcl_ms::BucketExchange {
 public:
-  ThreadExchange(Hub &hub, int process) : hub_(hub), process_(process) {}
-  int processes() const override { return hub_.processes(); }
-  int process() const override { return process_; }
+  ThreadExchange(Hub &hub, int process) : hub_(hub), group_(hub, process) {}
+  int processes() const override { return group_.processes(); }
+  int process() const override { return group_.process(); }
   void maxOver(std::vector<float> &values) override {
-    combine(values, [](float a, float b) { return std::max(a, b); });
+    group_.combine(values, [](float a, float b) { return std::max(a, b); });
   }
   void maxOver(std::vector<std::uint8_t> &values) override {
-    combine(values, [](std::uint8_t a, std::uint8_t b) { return std::max(a, b); });
+    group_.combine(values, [](std::uint8_t a, std::uint8_t b) { return std::max(a, b); });
   }
   void sumOver(std::vector<double> &values) override {
-    combine(values, [](double a, double b) { return a + b; });
+    group_.combine(values, [](double a, double b) { return a + b; });
   }
   void moveTriangles(const std::vector<Transfer> &transfers) override {
     for (const Transfer &transfer : transfers) {
-      if (transfer.from == process_)
-        hub_.posted()[process_] = transfer.triangles;
+      if (transfer.from == process())
+        hub_.posted()[process()] = transfer.triangles;
       hub_.wait();
-      if (transfer.to == process_)
+      if (transfer.to == process())
         *transfer.triangles =
             std::move(*static_cast<std::vector<pcl_ms::Triangle> *>(hub_.posted()[transfer.from]));
       hub_.wait();
@@ -47,28 +48,8 @@ public:
   int stages = 0;
 
 private:
-  /// Every process reads all values, then (after everyone has read) writes its own.
-  template <typename Value, typename Operation>
-  void combine(std::vector<Value> &values, Operation operation) {
-    hub_.posted()[process_] = &values;
-    hub_.wait();
-    std::vector<Value> combined = values;
-    for (int other = 0; other < hub_.processes(); ++other) {
-      const auto &theirs = *static_cast<const std::vector<Value> *>(hub_.posted()[other]);
-      if (theirs.size() != values.size()) { // not ASSERT: the others wait at the barrier
-        ADD_FAILURE() << "process " << other << " has " << theirs.size() << " values";
-        continue;
-      }
-      if (other != process_)
-        for (std::size_t i = 0; i < values.size(); ++i)
-          combined[i] = operation(combined[i], theirs[i]);
-    }
-    hub_.wait();
-    values = std::move(combined);
-  }
-
   Hub &hub_;
-  int process_;
+  ThreadGroup group_;
 };
 
 /// The shared-bucket tests: the bunny in buckets of 4,000 points, as one

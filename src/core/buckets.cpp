@@ -7,7 +7,7 @@
 #include <pcl_ms/mesh_points.h>
 #include <pcl_ms/reconstruct.h>
 
-#include "bucket_geometry.h"
+#include "bucket_parts.h"
 #include "median_spacing.h"
 #include "threads.h"
 
@@ -33,16 +33,8 @@ double secondsSince(Clock::time_point start) {
 
 using detail::Box;
 
-/// A node of the bucket tree. Leaves are buckets; an inner node's split
-/// plane is the seam between its two subtrees. Leaves are numbered in
-/// depth-first order, so a subtree's leaves form a range.
-struct Node {
-  Box region;
-  int axis = -1; // -1 for a leaf
-  double split = 0;
-  int children[2] = {-1, -1};
-  int depth = 0;
-  std::uint32_t first_leaf = 0, end_leaf = 0;
+/// A node of the bucket tree, with what one process keeps in it.
+struct Node : detail::TreeNode {
   std::vector<VertexIndex> points; // leaves: their points, ascending
   std::vector<Triangle> triangles; // kept so far in this subtree
 };
@@ -112,17 +104,7 @@ private:
   }
 
   int makeInner(const Box &region, int axis, double split, int depth, int left, int right) {
-    if (left < 0 || right < 0) // one side empty: no seam here
-      return left < 0 ? right : left;
-    Node node;
-    node.region = region;
-    node.axis = axis;
-    node.split = split;
-    node.depth = depth;
-    node.children[0] = left;
-    node.children[1] = right;
-    nodes_.push_back(std::move(node));
-    return static_cast<int>(nodes_.size() - 1);
+    return detail::addInner(nodes_, region, axis, split, depth, left, right);
   }
 
   /// Splits at the median of the longest side until buckets are small enough.
@@ -160,55 +142,29 @@ private:
                 const Box &region, std::array<int, 3> first, std::array<int, 3> last, int depth) {
     if (begin == end)
       return -1;
-    int axis = 0;
-    for (int a = 1; a < 3; ++a)
-      if (last[a] - first[a] > last[axis] - first[axis])
-        axis = a;
-    if (last[axis] - first[axis] <= 1)
+    const detail::GridHalves halves = detail::halveGrid(region, first, last, grid_low_, grid_cell_);
+    if (halves.leaf)
       return makeLeaf(order, begin, end, region, depth);
-    const int middle_cell = (first[axis] + last[axis]) / 2;
-    const double split = grid_low_[axis] + middle_cell * grid_cell_[axis];
     // Sides by the plane itself, so every point lies in its leaf's region:
     // a cell number computed as floor((p - low) / cell) can round across
     // the plane when coordinates span many orders of magnitude.
     const auto middle =
-        std::stable_partition(order.begin() + begin, order.begin() + end,
-                              [&](VertexIndex v) { return points_[v][axis] < split; });
+        std::stable_partition(order.begin() + begin, order.begin() + end, [&](VertexIndex v) {
+          return points_[v][halves.axis] < halves.split;
+        });
     const std::size_t middle_index = static_cast<std::size_t>(middle - order.begin());
-    Box left_region = region, right_region = region;
-    left_region.high[axis] = split;
-    right_region.low[axis] = split;
-    std::array<int, 3> left_last = last, right_first = first;
-    left_last[axis] = middle_cell;
-    right_first[axis] = middle_cell;
-    const int left =
-        buildGrid(order, begin, middle_index, left_region, first, left_last, depth + 1);
-    const int right =
-        buildGrid(order, middle_index, end, right_region, right_first, last, depth + 1);
-    return makeInner(region, axis, split, depth, left, right);
+    const int left = buildGrid(order, begin, middle_index, halves.left_region, first,
+                               halves.left_last, depth + 1);
+    const int right = buildGrid(order, middle_index, end, halves.right_region, halves.right_first,
+                                last, depth + 1);
+    return makeInner(region, halves.axis, halves.split, depth, left, right);
   }
 
-  void numberLeaves(int index) {
-    std::vector<std::pair<int, bool>> stack{{index, false}};
-    while (!stack.empty()) {
-      auto [current, children_done] = stack.back();
-      stack.pop_back();
-      Node &node = nodes_[current];
-      if (node.axis < 0) {
-        node.first_leaf = static_cast<std::uint32_t>(leaves_.size());
-        node.end_leaf = node.first_leaf + 1;
-        for (VertexIndex v : node.points)
-          leaf_of_[v] = node.first_leaf;
-        leaves_.push_back(current);
-      } else if (children_done) {
-        node.first_leaf = nodes_[node.children[0]].first_leaf;
-        node.end_leaf = nodes_[node.children[1]].end_leaf;
-      } else {
-        stack.push_back({current, true});
-        stack.push_back({node.children[1], false});
-        stack.push_back({node.children[0], false});
-      }
-    }
+  void numberLeaves(int root) {
+    leaves_ = detail::numberLeaves(nodes_, root);
+    for (int leaf : leaves_)
+      for (VertexIndex v : nodes_[static_cast<std::size_t>(leaf)].points)
+        leaf_of_[v] = nodes_[static_cast<std::size_t>(leaf)].first_leaf;
   }
 
   const std::vector<Eigen::Vector3d> &points_;
@@ -248,24 +204,7 @@ std::vector<double> bucketSpacings(const std::vector<Eigen::Vector3d> &points, B
   return spacings;
 }
 
-/// Calls progress one at a time from whichever thread finished a unit.
-class ProgressReporter {
-public:
-  ProgressReporter(const Parameters &parameters, std::size_t total)
-      : callback_(parameters.progress), total_(total) {}
-  void unitDone() {
-    if (!callback_)
-      return;
-    std::lock_guard<std::mutex> lock(mutex_);
-    callback_(++done_, total_);
-  }
-
-private:
-  const std::function<void(std::size_t, std::size_t)> &callback_;
-  std::size_t total_;
-  std::size_t done_ = 0;
-  std::mutex mutex_;
-};
+using detail::ProgressReporter;
 
 class BucketedMesher {
 public:

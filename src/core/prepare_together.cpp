@@ -10,6 +10,7 @@
 
 #include "far_points.h"
 #include "point_keys.h"
+#include "process_bytes.h"
 
 #include <tbb/parallel_sort.h>
 
@@ -23,41 +24,11 @@
 namespace pcl_ms {
 namespace {
 
-template <typename Value> std::vector<unsigned char> bytesOf(const Value *values, std::size_t n) {
-  static_assert(std::is_trivially_copyable_v<Value>);
-  std::vector<unsigned char> bytes(n * sizeof(Value));
-  if (n > 0)
-    std::memcpy(bytes.data(), values, bytes.size());
-  return bytes;
-}
-
-template <typename Value> std::vector<Value> valuesOf(const std::vector<unsigned char> &bytes) {
-  static_assert(std::is_trivially_copyable_v<Value>);
-  std::vector<Value> values(bytes.size() / sizeof(Value));
-  if (!values.empty())
-    std::memcpy(values.data(), bytes.data(), values.size() * sizeof(Value));
-  return values;
-}
-
-/// Each process's value, in process order, on every process.
-std::vector<std::uint64_t> perProcess(std::uint64_t mine, ProcessGroup &group) {
-  std::vector<std::uint64_t> values(static_cast<std::size_t>(group.processes()), 0);
-  values[static_cast<std::size_t>(group.process())] = mine;
-  group.sum(values);
-  return values;
-}
-
-std::uint64_t totalOver(std::uint64_t mine, ProcessGroup &group) {
-  std::vector<std::uint64_t> total{mine};
-  group.sum(total);
-  return total[0];
-}
-
-std::uint64_t maximumOver(std::uint64_t mine, ProcessGroup &group) {
-  std::vector<double> largest{static_cast<double>(mine)};
-  group.maximum(largest);
-  return static_cast<std::uint64_t>(largest[0]);
-}
+using detail::bytesOf;
+using detail::countsOf;
+using detail::maximumOver;
+using detail::totalOver;
+using detail::valuesOf;
 
 // ---- exact selection across processes ---------------------------------------
 
@@ -162,13 +133,12 @@ FarOutcome findFarPointsTogether(const std::vector<Eigen::Vector3f> &points, Pro
       outside.push_back(i);
       outside_points.push_back({points[i].x(), points[i].y(), points[i].z()});
     }
-  const std::vector<std::uint64_t> outside_counts = perProcess(outside.size(), group);
+  const std::vector<std::uint64_t> outside_counts = countsOf(outside.size(), group);
   std::uint64_t my_first = 0;
   for (int p = 0; p < group.process(); ++p)
     my_first += outside_counts[static_cast<std::size_t>(p)];
   std::vector<Eigen::Vector3f> all_outside;
-  for (const auto &p : valuesOf<std::array<float, 3>>(
-           group.gatherAll(bytesOf(outside_points.data(), outside_points.size()))))
+  for (const auto &p : valuesOf<std::array<float, 3>>(group.gatherAll(bytesOf(outside_points))))
     all_outside.emplace_back(p[0], p[1], p[2]);
   const std::vector<bool> isolated =
       detail::isolatedOutside(std::move(all_outside), central_low, central_high, size);
@@ -291,7 +261,7 @@ PreparedSlice sliceOf(const std::vector<Item> &run, const Eigen::Vector3d &centr
       if (with_normals)
         points.normals.push_back(detail::unitNormalOrZero(run[i].normal.data()));
   }
-  const std::vector<std::uint64_t> distinct = perProcess(points.positions.size(), group);
+  const std::vector<std::uint64_t> distinct = countsOf(points.positions.size(), group);
   for (int p = 0; p < group.process(); ++p)
     slice.first += distinct[static_cast<std::size_t>(p)];
   for (std::uint64_t d : distinct)

@@ -12,8 +12,9 @@
 #include <pcl_ms/prepared_points.h>
 #include <pcl_ms/reconstruct.h>
 
-#include "bucket_geometry.h"
+#include "bucket_parts.h"
 #include "median_spacing.h"
+#include "process_bytes.h"
 #include "threads.h"
 
 #include <tbb/blocked_range.h>
@@ -34,98 +35,16 @@ namespace pcl_ms {
 namespace {
 
 using detail::Box;
+using detail::bytesOf;
+using detail::countsOf;
+using detail::deliver;
+using detail::gatherAtZero;
+using detail::totalOver;
+using detail::valuesOf;
 using Clock = std::chrono::steady_clock;
 
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-// ---- moving plain data between processes -----------------------------------
-
-template <typename Value> std::vector<unsigned char> bytesOf(const std::vector<Value> &values) {
-  static_assert(std::is_trivially_copyable_v<Value>);
-  std::vector<unsigned char> bytes(values.size() * sizeof(Value));
-  if (!values.empty())
-    std::memcpy(bytes.data(), values.data(), bytes.size());
-  return bytes;
-}
-
-template <typename Value> std::vector<Value> valuesOf(const std::vector<unsigned char> &bytes) {
-  static_assert(std::is_trivially_copyable_v<Value>);
-  std::vector<Value> values(bytes.size() / sizeof(Value));
-  if (!values.empty())
-    std::memcpy(values.data(), bytes.data(), values.size() * sizeof(Value));
-  return values;
-}
-
-/// Sends outgoing[p] to process p (and empties it); calls take(value) for
-/// every value sent here, in process order. The values are read straight
-/// from the bytes received: no second copy of them is held.
-template <typename Value, typename Take>
-void deliver(std::vector<std::vector<Value>> &outgoing, ProcessGroup &group, const Take &take) {
-  std::vector<std::vector<unsigned char>> bytes(outgoing.size());
-  for (std::size_t p = 0; p < outgoing.size(); ++p) {
-    bytes[p] = bytesOf(outgoing[p]);
-    std::vector<Value>().swap(outgoing[p]);
-  }
-  const std::vector<unsigned char> received = group.exchange(bytes);
-  bytes.clear();
-  for (std::size_t at = 0; at + sizeof(Value) <= received.size(); at += sizeof(Value)) {
-    Value value;
-    std::memcpy(&value, received.data() + at, sizeof value);
-    take(value);
-  }
-}
-
-/// Each process's count, in process order, on every process.
-std::vector<std::uint64_t> countsOf(std::uint64_t mine, ProcessGroup &group) {
-  std::vector<std::uint64_t> counts(static_cast<std::size_t>(group.processes()), 0);
-  counts[static_cast<std::size_t>(group.process())] = mine;
-  group.sum(counts);
-  return counts;
-}
-
-/// Process 0 gets every process's `count` values (make(i) gives value i):
-/// take(position, value) with the value's position in the processes'
-/// order. Sent in rounds of at most a million values a process, so that
-/// neither side holds all the bytes at once.
-template <typename Value, typename Make, typename Take>
-void gatherAtZero(std::size_t count, const Make &make, const Take &take, ProcessGroup &group) {
-  constexpr std::size_t chunk = std::size_t{1} << 20;
-  const std::vector<std::uint64_t> counts = countsOf(count, group);
-  std::vector<std::uint64_t> firsts(counts.size(), 0);
-  std::uint64_t rounds = 0;
-  for (std::size_t p = 0; p < counts.size(); ++p) {
-    firsts[p] = p == 0 ? 0 : firsts[p - 1] + counts[p - 1];
-    rounds = std::max<std::uint64_t>(rounds, (counts[p] + chunk - 1) / chunk);
-  }
-  for (std::uint64_t round = 0; round < rounds; ++round) {
-    std::vector<std::vector<unsigned char>> outgoing(counts.size());
-    const std::size_t begin = std::min<std::size_t>(count, round * chunk);
-    const std::size_t end = std::min<std::size_t>(count, begin + chunk);
-    outgoing[0].resize((end - begin) * sizeof(Value));
-    for (std::size_t i = begin; i < end; ++i) {
-      const Value value = make(i);
-      std::memcpy(outgoing[0].data() + (i - begin) * sizeof(Value), &value, sizeof value);
-    }
-    const std::vector<unsigned char> received = group.exchange(outgoing);
-    std::size_t at = 0;
-    for (std::size_t p = 0; p < counts.size() && group.process() == 0; ++p) {
-      const std::uint64_t from = std::min<std::uint64_t>(counts[p], round * chunk);
-      const std::uint64_t to = std::min<std::uint64_t>(counts[p], from + chunk);
-      for (std::uint64_t i = from; i < to; ++i, at += sizeof(Value)) {
-        Value value;
-        std::memcpy(&value, received.data() + at, sizeof value);
-        take(static_cast<std::size_t>(firsts[p] + i), value);
-      }
-    }
-  }
-}
-
-std::uint64_t totalOver(std::uint64_t mine, ProcessGroup &group) {
-  std::vector<std::uint64_t> total{mine};
-  group.sum(total);
-  return total[0];
 }
 
 /// A prepared point's data as it travels to process 0.
@@ -183,15 +102,8 @@ struct SplitKey {
   }
 };
 
-/// One node of the bucket tree, the same on every process.
-struct Node {
-  Box region;
-  int axis = -1; // -1 for a leaf
-  double split = 0;
-  int children[2] = {-1, -1};
-  int depth = 0;
-  std::uint32_t first_leaf = 0, end_leaf = 0;
-};
+/// The tree's nodes are the same on every process.
+using Node = detail::TreeNode;
 
 /// The points of all processes in buckets and seam zones, by owner.
 class SharedBuckets {
@@ -278,17 +190,7 @@ private:
   }
 
   int makeInner(const Box &region, int axis, double split, int depth, int left, int right) {
-    if (left < 0 || right < 0) // one side empty: no seam here
-      return left < 0 ? right : left;
-    Node node;
-    node.region = region;
-    node.axis = axis;
-    node.split = split;
-    node.depth = depth;
-    node.children[0] = left;
-    node.children[1] = right;
-    nodes_.push_back(node);
-    return static_cast<int>(nodes_.size() - 1);
+    return detail::addInner(nodes_, region, axis, split, depth, left, right);
   }
 
   /// As one process splits (buckets.cpp, BucketTree::buildMedian): at the
@@ -328,28 +230,18 @@ private:
                 std::array<int, 3> last, int depth) {
     if (totalOver(members.size(), group_) == 0)
       return -1;
-    int axis = 0;
-    for (int a = 1; a < 3; ++a)
-      if (last[a] - first[a] > last[axis] - first[axis])
-        axis = a;
-    if (last[axis] - first[axis] <= 1)
+    const detail::GridHalves halves = detail::halveGrid(region, first, last, grid_low_, grid_cell_);
+    if (halves.leaf)
       return makeLeaf(std::move(members), region, depth);
-    const int middle_cell = (first[axis] + last[axis]) / 2;
-    const double split = grid_low_[axis] + middle_cell * grid_cell_[axis];
     std::vector<std::uint32_t> left_members, right_members;
     for (std::uint32_t i : members)
-      (home_.positions[i][axis] < split ? left_members : right_members).push_back(i);
+      (home_.positions[i][halves.axis] < halves.split ? left_members : right_members).push_back(i);
     std::vector<std::uint32_t>().swap(members);
-    Box left_region = region, right_region = region;
-    left_region.high[axis] = split;
-    right_region.low[axis] = split;
-    std::array<int, 3> left_last = last, right_first = first;
-    left_last[axis] = middle_cell;
-    right_first[axis] = middle_cell;
-    const int left = buildGrid(std::move(left_members), left_region, first, left_last, depth + 1);
-    const int right =
-        buildGrid(std::move(right_members), right_region, right_first, last, depth + 1);
-    return makeInner(region, axis, split, depth, left, right);
+    const int left =
+        buildGrid(std::move(left_members), halves.left_region, first, halves.left_last, depth + 1);
+    const int right = buildGrid(std::move(right_members), halves.right_region, halves.right_first,
+                                last, depth + 1);
+    return makeInner(region, halves.axis, halves.split, depth, left, right);
   }
 
   void buildTree() {
@@ -376,25 +268,7 @@ private:
 
   /// Depth-first, as one process numbers them: a subtree's leaves form a range.
   void numberLeaves() {
-    std::vector<int> leaf_number(nodes_.size(), -1);
-    std::vector<std::pair<int, bool>> stack{{root_, false}};
-    while (!stack.empty()) {
-      auto [current, children_done] = stack.back();
-      stack.pop_back();
-      Node &node = nodes_[static_cast<std::size_t>(current)];
-      if (node.axis < 0) {
-        node.first_leaf = static_cast<std::uint32_t>(leaves_.size());
-        node.end_leaf = node.first_leaf + 1;
-        leaves_.push_back(current);
-      } else if (children_done) {
-        node.first_leaf = nodes_[static_cast<std::size_t>(node.children[0])].first_leaf;
-        node.end_leaf = nodes_[static_cast<std::size_t>(node.children[1])].end_leaf;
-      } else {
-        stack.push_back({current, true});
-        stack.push_back({node.children[1], false});
-        stack.push_back({node.children[0], false});
-      }
-    }
+    leaves_ = detail::numberLeaves(nodes_, root_);
     for (std::size_t k = 0; k < leaf_node_.size(); ++k) {
       const std::uint32_t leaf = nodes_[static_cast<std::size_t>(leaf_node_[k])].first_leaf;
       for (std::uint32_t i : leaf_members_[k])
@@ -527,8 +401,9 @@ private:
       ++margin_points[ownSlot(arrived.unit)];
     });
 
-    progress_ = std::make_unique<ProgressCounter>(parameters_, own_leaves_.size() + ownZones());
-    ProgressCounter &progress = *progress_;
+    progress_ =
+        std::make_unique<detail::ProgressReporter>(parameters_, own_leaves_.size() + ownZones());
+    detail::ProgressReporter &progress = *progress_;
     std::vector<BucketOutcome> outcomes(own_leaves_.size());
     leaf_triangles_.resize(own_leaves_.size());
     // Per bucket: its core points' scales and the vertices that may pinch,
@@ -659,25 +534,6 @@ private:
   }
 
   // ---- the seams -----------------------------------------------------------------
-
-  /// Calls progress one at a time from whichever thread finished a unit.
-  class ProgressCounter {
-  public:
-    ProgressCounter(const Parameters &parameters, std::size_t total)
-        : callback_(parameters.progress), total_(total) {}
-    void unitDone() {
-      if (!callback_)
-        return;
-      std::lock_guard<std::mutex> lock(mutex_);
-      callback_(++done_, total_);
-    }
-
-  private:
-    const std::function<void(std::size_t, std::size_t)> &callback_;
-    std::size_t total_;
-    std::size_t done_ = 0;
-    std::mutex mutex_;
-  };
 
   /// Calls visit(i) for every home point i inside `box`. Home points are in
   /// Morton order, so runs of them are compact: runs whose bounding box
@@ -1004,7 +860,7 @@ private:
   std::vector<std::uint32_t> own_leaves_; // ascending
   std::vector<std::vector<Triangle>> leaf_triangles_;
   std::unordered_map<int, std::vector<Triangle>> node_triangles_;
-  std::unique_ptr<ProgressCounter> progress_;
+  std::unique_ptr<detail::ProgressReporter> progress_;
   double d_med_ = 0;
   BucketStatistics statistics_;
   double timings_[3] = {0, 0, 0};

@@ -63,6 +63,17 @@ std::vector<std::size_t> cutsFor(std::size_t records, const std::vector<double> 
   return cuts;
 }
 
+/// Process p's part of `xyz` (and `normals`, if any) cut at `cuts`.
+pcl_ms::PointView partOf(const std::vector<float> &xyz, const std::vector<float> &normals,
+                         const std::vector<std::size_t> &cuts, int p) {
+  pcl_ms::PointView part;
+  part.size = cuts[p + 1] - cuts[p];
+  part.xyz = xyz.data() + 3 * cuts[p];
+  if (!normals.empty())
+    part.normals = normals.data() + 3 * cuts[p];
+  return part;
+}
+
 struct Joined {
   pcl_ms::PreparedPoints points;
   pcl_ms::PreparationCounts counts;
@@ -77,12 +88,8 @@ Joined prepareInParts(const std::vector<float> &xyz, const std::vector<float> &n
   std::vector<pcl_ms::PreparedSlice> slices(processes);
   onThreadProcesses(processes, [&](pcl_ms::ProcessGroup &group) {
     const int p = group.process();
-    pcl_ms::PointView part;
-    part.size = cuts[p + 1] - cuts[p];
-    part.xyz = xyz.data() + 3 * cuts[p];
-    if (!normals.empty())
-      part.normals = normals.data() + 3 * cuts[p];
-    slices[p] = pcl_ms::preparePointsTogether(part, cuts[p], !normals.empty(), group);
+    slices[p] = pcl_ms::preparePointsTogether(partOf(xyz, normals, cuts, p), cuts[p],
+                                              !normals.empty(), group);
   });
   Joined joined;
   joined.counts = slices[0].counts;
@@ -169,11 +176,8 @@ TEST(PrepareTogether, TooFewPointsFailOnEveryProcessAsInOne) {
   std::vector<std::string> errors(cuts.size() - 1);
   onThreadProcesses(static_cast<int>(cuts.size()) - 1, [&](pcl_ms::ProcessGroup &group) {
     const int p = group.process();
-    pcl_ms::PointView part;
-    part.size = cuts[p + 1] - cuts[p];
-    part.xyz = xyz.data() + 3 * cuts[p];
     try {
-      pcl_ms::preparePointsTogether(part, cuts[p], false, group);
+      pcl_ms::preparePointsTogether(partOf(xyz, {}, cuts, p), cuts[p], false, group);
     } catch (const pcl_ms::ReconstructionError &error) {
       errors[p] = error.what();
     }
@@ -194,14 +198,10 @@ std::vector<pcl_ms::Result> reconstructInParts(const std::vector<float> &xyz,
   std::vector<pcl_ms::Result> results(processes);
   onThreadProcesses(processes, [&](pcl_ms::ProcessGroup &group) {
     const int p = group.process();
-    pcl_ms::PointView part;
-    part.size = cuts[p + 1] - cuts[p];
-    part.xyz = xyz.data() + 3 * cuts[p];
-    if (!normals.empty())
-      part.normals = normals.data() + 3 * cuts[p];
     results[p] = pcl_ms::reconstructSlices(
-        pcl_ms::preparePointsTogether(part, cuts[p], parameters.use_normals, group), parameters,
-        group);
+        pcl_ms::preparePointsTogether(partOf(xyz, normals, cuts, p), cuts[p],
+                                      parameters.use_normals, group),
+        parameters, group);
   });
   return results;
 }
@@ -286,12 +286,10 @@ TEST(BucketsByOwner, NoBucketMeshedFailsOnEveryProcessAsInOne) {
   std::vector<std::string> errors(3);
   onThreadProcesses(3, [&](pcl_ms::ProcessGroup &group) {
     const int p = group.process();
-    pcl_ms::PointView part;
-    part.size = cuts[p + 1] - cuts[p];
-    part.xyz = xyz.data() + 3 * cuts[p];
     try {
-      pcl_ms::reconstructSlices(pcl_ms::preparePointsTogether(part, cuts[p], false, group),
-                                parameters, group);
+      pcl_ms::reconstructSlices(
+          pcl_ms::preparePointsTogether(partOf(xyz, {}, cuts, p), cuts[p], false, group),
+          parameters, group);
     } catch (const pcl_ms::ReconstructionError &error) {
       errors[p] = error.what();
     }

@@ -80,15 +80,7 @@ public:
     return received;
   }
 
-private:
-  template <typename Read> void share(const void *mine, const Read &read) {
-    hub_.posted()[process_] = const_cast<void *>(mine); // the others only read it
-    hub_.wait();
-    for (int other = 0; other < hub_.processes(); ++other)
-      read(other, hub_.posted()[other]);
-    hub_.wait();
-  }
-
+  /// Element-wise operation(mine, theirs) over all processes' `values`.
   template <typename Value, typename Operation>
   void combine(std::vector<Value> &values, Operation operation) {
     std::vector<Value> combined = values;
@@ -103,6 +95,17 @@ private:
           combined[i] = operation(combined[i], their_values[i]);
     });
     values = std::move(combined);
+  }
+
+private:
+  /// Posts this process's data, lets read(other, data) see every process's
+  /// after a barrier, and waits until all have read before returning.
+  template <typename Read> void share(const void *mine, const Read &read) {
+    hub_.posted()[process_] = const_cast<void *>(mine); // the others only read it
+    hub_.wait();
+    for (int other = 0; other < hub_.processes(); ++other)
+      read(other, hub_.posted()[other]);
+    hub_.wait();
   }
 
   Hub &hub_;

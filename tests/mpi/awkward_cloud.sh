@@ -51,17 +51,11 @@ status=0
 "$build/pcl_ms_reconstruct" "$work/too_few.pcd" "$work/one.ply" 2> "$work/one_error.txt" ||
   status=$?
 [[ $status == 3 ]] || { echo "FAIL: one process exited with $status, expected 3"; exit 1; }
-"$mpiexec" "${mpirun_flags[@]}" -np "$ranks" bash -c \
-  '"$0" "$1" "$2"; echo "$?" > "$3/exit.$OMPI_COMM_WORLD_RANK"' \
-  "$build/pcl_ms_reconstruct_mpi" "$work/too_few.pcd" "$work/out.ply" "$work" \
-  2> "$work/ranks_error.txt" || true
-cat "$work/ranks_error.txt"
+record_rank_exits "$build/pcl_ms_reconstruct_mpi" "$work/too_few.pcd" "$work/out.ply"
+cat "$work/stderr.txt"
 [[ -e $work/out.ply ]] && { echo "FAIL: a mesh was written"; exit 1; }
 diff <(sed 's/\x1b\[[0-9;]*m//g' "$work/one_error.txt") \
-  <(sed 's/\x1b\[[0-9;]*m//g' "$work/ranks_error.txt") ||
+  <(sed 's/\x1b\[[0-9;]*m//g' "$work/stderr.txt") ||
   { echo "FAIL: the ranks gave another reason than one process, or more than once"; exit 1; }
-for ((rank = 0; rank < ranks; ++rank)); do
-  code=$(cat "$work/exit.$rank" 2> /dev/null || echo none)
-  [[ $code == 3 ]] || { echo "FAIL: rank $rank exited with $code, expected 3"; exit 1; }
-done
+expect_rank_exits 3 "reconstruction failed"
 echo "too few points: all $ranks ranks exited with 3, with one process's reason"

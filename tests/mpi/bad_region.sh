@@ -19,10 +19,8 @@ fi
 # 100 bytes fewer: part of the last record or records, none of the others'.
 head -c $(($(stat -c %s "$input") - 100)) "$input" > "$work/cut.$ext"
 started=$SECONDS
-"$mpiexec" "${mpirun_flags[@]}" -np "$ranks" bash -c \
-  '"$0" "$1" "$2" -bucket_points 4000; echo "$?" > "$3/exit.$OMPI_COMM_WORLD_RANK"' \
-  "$build/pcl_ms_reconstruct_mpi" "$work/cut.$ext" "$work/out.ply" "$work" \
-  > "$work/stdout.txt" 2> "$work/stderr.txt" || true
+record_rank_exits "$build/pcl_ms_reconstruct_mpi" "$work/cut.$ext" "$work/out.ply" \
+  -bucket_points 4000
 took=$((SECONDS - started))
 cat "$work/stderr.txt"
 [[ -e $work/out.ply ]] && { echo "FAIL: a mesh was written"; exit 1; }
@@ -34,10 +32,6 @@ if ((ranks > 1)) && grep -v "rank $last:" "$work/stderr.txt" | grep -q '^error:'
   exit 1
 fi
 grep -q 'Reconstructing' "$work/stdout.txt" && { echo "FAIL: meshing started"; exit 1; }
-for ((rank = 0; rank < ranks; ++rank)); do
-  [[ -e $work/exit.$rank ]] || { echo "FAIL: rank $rank did not exit"; exit 1; }
-  code=$(cat "$work/exit.$rank")
-  [[ $code == 2 ]] || { echo "FAIL: rank $rank exited with $code, expected 2 (file error)"; exit 1; }
-done
+expect_rank_exits 2 "file error"
 ((took <= 20)) || { echo "FAIL: the job took $took s"; exit 1; }
 echo "rank $last's range was cut short: all $ranks ranks exited with 2 within $took s"

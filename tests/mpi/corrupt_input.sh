@@ -8,19 +8,13 @@ build=$1 mpiexec=$2 ranks=$3 input=$4
 source "$(dirname "${BASH_SOURCE[0]}")/job_setup.sh"
 
 head -c $(($(stat -c %s "$input") / 2)) "$input" > "$work/truncated.pcd"
-"$mpiexec" "${mpirun_flags[@]}" -np "$ranks" bash -c \
-  '"$0" "$1" "$2" -bucket_points 4000; echo "$?" > "$3/exit.$OMPI_COMM_WORLD_RANK"' \
-  "$build/pcl_ms_reconstruct_mpi" "$work/truncated.pcd" "$work/out.ply" "$work" \
-  2> "$work/stderr.txt" || true
+record_rank_exits "$build/pcl_ms_reconstruct_mpi" "$work/truncated.pcd" "$work/out.ply" \
+  -bucket_points 4000
 cat "$work/stderr.txt"
 [[ -e $work/out.ply ]] && { echo "FAIL: a mesh was written"; exit 1; }
 grep -q '^error: .*truncated.pcd' "$work/stderr.txt" ||
   { echo "FAIL: no 'error:' line naming the file"; exit 1; }
-for ((rank = 0; rank < ranks; ++rank)); do
-  [[ -e $work/exit.$rank ]] || { echo "FAIL: rank $rank did not exit"; exit 1; }
-  code=$(cat "$work/exit.$rank")
-  [[ $code == 2 ]] || { echo "FAIL: rank $rank exited with $code, expected 2 (file error)"; exit 1; }
-done
+expect_rank_exits 2 "file error"
 # Without the wrapper, mpirun itself reports the failure.
 status=0
 "$mpiexec" "${mpirun_flags[@]}" -np "$ranks" "$build/pcl_ms_reconstruct_mpi" \

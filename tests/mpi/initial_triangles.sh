@@ -17,15 +17,10 @@ ONE_PIECE=1 bash "$here/same_mesh.sh" "$build" "$mpiexec" "$ranks" "$input" \
 [[ $mode == fixed ]] || exit 0
 
 "$build/pcl_ms_reconstruct" "$foreign" "$work/foreign.ply" -q
-"$mpiexec" "${mpirun_flags[@]}" -np "$ranks" bash -c \
-  '"$0" "$1" "$2" -initial "$3"; echo "$?" > "$4/exit.$OMPI_COMM_WORLD_RANK"' \
-  "$build/pcl_ms_reconstruct_mpi" "$input" "$work/out.ply" "$work/foreign.ply" "$work" \
-  > "$work/stdout.txt" 2> "$work/stderr.txt" || true
+record_rank_exits "$build/pcl_ms_reconstruct_mpi" "$input" "$work/out.ply" \
+  -initial "$work/foreign.ply"
 grep -q "^error: -initial: vertex .* is not a point of" "$work/stderr.txt" ||
   { cat "$work/stderr.txt"; echo "FAIL: no error naming the foreign vertex"; exit 1; }
-for ((rank = 0; rank < ranks; ++rank)); do
-  code=$(cat "$work/exit.$rank" 2>/dev/null || echo none)
-  [[ $code == 1 ]] || { echo "FAIL: rank $rank exited with $code, expected 1"; exit 1; }
-done
+expect_rank_exits 1 "bad arguments"
 [[ -e $work/out.ply ]] && { echo "FAIL: a mesh was written"; exit 1; }
 echo "a foreign initial mesh in fixed mode: every rank exited with 1"
