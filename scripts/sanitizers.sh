@@ -103,7 +103,10 @@ cmake --build build-tsan -j"${JOBS}" --target pcl_ms_tests pcl_ms_core_tests
 # Threaded tests on small clouds: under TSan the large-cloud bucket and
 # determinism tests take minutes each, and their TBB loops are suppressed
 # anyway (tsan.supp). The fuzz corpus brings bucketed runs on 2 threads;
-# BucketExchange runs the bunny as 2, 3 and 24 processes sharing buckets.
-./build-tsan/pcl_ms_core_tests --gtest_filter='Finish.*'
+# BucketExchange runs the bunny as 2, 3 and 24 processes sharing buckets;
+# PrepareTogether and BucketsByOwner prepare and mesh it in parts (threads
+# standing in for processes), as does the shared_reconstruct corpus.
+./build-tsan/pcl_ms_core_tests \
+  --gtest_filter='Finish.*:PrepareTogether.*:BucketsByOwner.GridAndNormals*:BucketsByOwner.FewPoints*:BucketsByOwner.NoBucket*:BucketsByOwner.OnePiece*'
 ./build-tsan/pcl_ms_tests --gtest_filter='TimeLimit*.*:FuzzCorpus.*:BucketExchange.*:Buckets.AutomaticChoiceDependsOnTheCloudSizeOnly:Buckets.InvalidBucketParametersAreRejected:Buckets.OneUnitKeepsOnlyTrianglesOnItsCorePoints'
 echo "sanitizers: ASan/UBSan tests, fuzzing and TSan tests passed"

@@ -14,6 +14,7 @@
 #include "fuzz/mesh_quality_fuzzer.cpp"
 #include "fuzz/reconstruct_fuzzer.cpp"
 #include "fuzz/reconstruct_inputs_fuzzer.cpp"
+#include "fuzz/shared_reconstruct_fuzzer.cpp"
 
 #include <gtest/gtest.h>
 
@@ -53,6 +54,10 @@ TEST(FuzzCorpus, ReconstructRunsEveryInputToAMeshOrAnError) {
 
 TEST(FuzzCorpus, ReconstructWithEveryOptionalInputRunsToAMeshOrAnError) {
   replayCorpus("reconstruct_inputs", &pcl_ms_fuzz::reconstructInputsOneInput);
+}
+
+TEST(FuzzCorpus, ProcessesSharingACloudGiveOneProcessMeshOrError) {
+  replayCorpus("shared_reconstruct", &pcl_ms_fuzz::sharedReconstructOneInput);
 }
 
 TEST(FuzzCorpus, MeshMetricsAreConsistentOnEveryPairOfMeshes) {
