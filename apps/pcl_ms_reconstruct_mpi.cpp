@@ -346,8 +346,9 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
   const bool on_rank_zero = job.rank == 0;
   const bool verbose = on_rank_zero && !options.quiet;
   pcl::PointCloud<PointT> points; // rank 0's whole cloud, unless the ranks prepare parts
-  // Read in parts (without initial triangles, which need the whole cloud on
-  // rank 0): each rank's slice of the points, prepared together.
+  // Read in parts by several ranks (without initial triangles, which need
+  // the whole cloud on rank 0): each rank's slice of the points, prepared
+  // together.
   std::optional<pcl_ms::PreparedSlice> slice;
   double prepare_seconds = 0;
   SliceStatus read;
@@ -378,7 +379,8 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
       print_info("Available dimensions: ");
       print_value("%s\n", fields.c_str());
     }
-    if (initial.empty()) {
+    // One rank alone meshes as one process does: sharing would only copy.
+    if (initial.empty() && job.ranks > 1) {
       const auto prepare_start = std::chrono::steady_clock::now();
       slice.emplace();
       const int prepared = prepareParts(job, std::move(part), parameters, *slice);

@@ -174,7 +174,9 @@ FarOutcome findFarPointsTogether(const std::vector<Eigen::Vector3f> &points, Pro
 struct KeyedNormal {
   detail::PointKey key;
   std::array<float, 3> normal;
+  std::uint32_t padding = 0; // travels as bytes: none left unset
 };
+static_assert(sizeof(KeyedNormal) == 40, "travels as bytes, without unset padding");
 
 const detail::PointKey &keyOf(const detail::PointKey &item) { return item; }
 const detail::PointKey &keyOf(const KeyedNormal &item) { return item.key; }

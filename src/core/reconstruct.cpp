@@ -115,12 +115,6 @@ std::string tooFewPoints(const PreparationCounts &counts, std::size_t distinct) 
   return reason.str();
 }
 
-namespace {
-
-constexpr VertexIndex not_prepared = std::numeric_limits<VertexIndex>::max();
-
-} // namespace
-
 /// Prepares the distinct, finite points in Morton (Z-curve) order. Every
 /// later stage walks the points' neighbourhoods: with neighbours at nearby
 /// indices their arrays stay in cache, which saves about a fifth of the time

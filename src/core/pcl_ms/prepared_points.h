@@ -13,10 +13,14 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
 namespace pcl_ms {
+
+/// PreparedPoints::prepared_of_record's entry for a record left out.
+constexpr VertexIndex not_prepared = std::numeric_limits<VertexIndex>::max();
 
 /// The distinct, finite points of the user's records, centred, in Morton
 /// order, and for each the user record it stands for.
