@@ -2,15 +2,17 @@
 // pcl_ms_reconstruct_mpi: pcl_ms_reconstruct across the ranks of an MPI job,
 // with the same options and the same triangles for any number of ranks.
 //
-// The ranks read their own byte ranges of a binary PCD or PLY and prepare
-// them together (pcl_ms::preparePointsTogether), then send the prepared
-// points to rank 0 (other formats: rank 0 reads and prepares). Rank 0 builds
-// the bucket tree and hands each bucket and seam zone as a task to a free
-// rank (pcl_ms_mpi::MpiUnitFarm), meshing one itself meanwhile; the other
-// ranks hold one unit at a time, never the cloud (docs/algorithm.md,
+// The ranks read their own byte ranges of a binary PCD or PLY, prepare them
+// together (pcl_ms::preparePointsTogether) and mesh them by owner
+// (pcl_ms::reconstructSlices): each rank its own buckets and seam zones, no
+// rank holding the cloud until rank 0 receives the surface to finish. A
+// file rank 0 reads whole (other formats) is meshed by a unit farm: rank 0
+// prepares it, builds the bucket tree and hands each bucket and seam zone
+// as a task to a free rank (pcl_ms_mpi::MpiUnitFarm), meshing one itself
+// meanwhile; the other ranks hold one unit at a time (docs/algorithm.md,
 // "Across processes"). Rank 0 finishes the surface (hole filling,
-// orientation) and writes the mesh. With -initial, rank 0 meshes the cloud
-// alone in one piece, as pcl_ms_reconstruct does.
+// orientation) and writes the mesh. With -initial, or on one rank, rank 0
+// meshes the cloud alone, as pcl_ms_reconstruct does.
 //
 // Failures: what every rank would see the same way (arguments, the file) is
 // agreed on and every rank exits with the same code; a failure on one rank
