@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Stage 5 with the points spread over processes (docs/algorithm.md, "Across
-// processes", "Buckets by owner"). In: each process's slice of the prepared
+// processes", "By owner, from slices"). In: each process's slice of the prepared
 // points (its "home" points). Out: on process 0, the surface and the points
 // that one process meshing the whole cloud in buckets (buckets.cpp) would
 // have. No process holds the cloud while meshing: the tree is cut with
@@ -71,9 +71,16 @@ struct PointFor {
   std::uint32_t unit, padding = 0;
 };
 
+/// A point by index, with the unit that asks for it (or 0).
 struct IndexFor {
   VertexIndex index;
   std::uint32_t unit;
+};
+
+/// A point's local scale, on its way home.
+struct ScaleFor {
+  VertexIndex index;
+  float scale;
 };
 
 struct TriangleFor {
@@ -408,8 +415,8 @@ private:
     leaf_triangles_.resize(own_leaves_.size());
     // Per bucket: its core points' scales and the vertices that may pinch,
     // to go back to the points' homes.
-    std::vector<std::vector<IndexFor>> scales_of(own_leaves_.size()),
-        pinches_of(own_leaves_.size());
+    std::vector<std::vector<ScaleFor>> scales_of(own_leaves_.size());
+    std::vector<std::vector<IndexFor>> pinches_of(own_leaves_.size());
     detail::threadArena(parameters_.num_threads).execute([&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, own_leaves_.size(), 1),
                         [&](const tbb::blocked_range<std::size_t> &range) {
@@ -429,11 +436,8 @@ private:
                             leaf_triangles_[k] = toGlobal(outcome.triangles, points);
                             if (!outcome.local_scale.empty())
                               for (std::size_t i = 0; i < points.size(); ++i)
-                                if (points[i].leaf == own_leaves_[k]) {
-                                  std::uint32_t bits;
-                                  std::memcpy(&bits, &outcome.local_scale[i], sizeof bits);
-                                  scales_of[k].push_back({points[i].index, bits});
-                                }
+                                if (points[i].leaf == own_leaves_[k])
+                                  scales_of[k].push_back({points[i].index, outcome.local_scale[i]});
                             for (VertexIndex v : outcome.cut_vertices)
                               pinches_of[k].push_back({points[v].index, 0});
                             // Only the figures stay: the bucket's points and arrays go.
@@ -445,18 +449,18 @@ private:
                           }
                         });
     });
-    std::vector<std::vector<IndexFor>> scales(processes), pinches(processes);
+    std::vector<std::vector<ScaleFor>> scales(processes);
+    std::vector<std::vector<IndexFor>> pinches(processes);
     for (std::size_t k = 0; k < own_leaves_.size(); ++k) {
-      for (const IndexFor &scale : scales_of[k])
+      for (const ScaleFor &scale : scales_of[k])
         scales[static_cast<std::size_t>(homeOf(scale.index))].push_back(scale);
       for (const IndexFor &pinch : pinches_of[k])
         pinches[static_cast<std::size_t>(homeOf(pinch.index))].push_back(pinch);
-      std::vector<IndexFor>().swap(scales_of[k]);
+      std::vector<ScaleFor>().swap(scales_of[k]);
       std::vector<IndexFor>().swap(pinches_of[k]);
     }
-    deliver(scales, group_, [&](const IndexFor &scale) {
-      std::memcpy(&home_scale_[scale.index - first_], &scale.unit, sizeof(float));
-    });
+    deliver(scales, group_,
+            [&](const ScaleFor &scale) { home_scale_[scale.index - first_] = scale.scale; });
     deliver(pinches, group_, [&](const IndexFor &pinch) { home_pinch_[pinch.index - first_] = 1; });
 
     // The buckets' figures: only the owner's entry is non-zero.
