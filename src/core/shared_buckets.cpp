@@ -15,6 +15,7 @@
 #include "bucket_parts.h"
 #include "median_spacing.h"
 #include "process_bytes.h"
+#include "shared_tree.h"
 #include "threads.h"
 
 #include <tbb/blocked_range.h>
@@ -88,28 +89,6 @@ struct TriangleFor {
   std::uint32_t node;
 };
 
-// ---- exact selection of a split across processes ----------------------------
-
-/// Orders doubles as integers: negative below positive, -0 as +0 (one
-/// process's comparison finds them equal and breaks the tie by index).
-std::uint64_t orderKey(double value) {
-  if (value == 0)
-    value = 0.0;
-  std::uint64_t bits;
-  std::memcpy(&bits, &value, sizeof bits);
-  return bits & (std::uint64_t{1} << 63) ? ~bits : bits | (std::uint64_t{1} << 63);
-}
-
-/// (coordinate, index) as one process's median split orders points.
-struct SplitKey {
-  std::uint64_t coordinate;
-  VertexIndex index;
-  bool operator<(const SplitKey &other) const {
-    return coordinate < other.coordinate || (coordinate == other.coordinate && index < other.index);
-  }
-};
-
-/// The tree's nodes are the same on every process.
 using Node = detail::TreeNode;
 
 /// The points of all processes in buckets and seam zones, by owner.
@@ -118,8 +97,8 @@ public:
   SharedBuckets(const PreparedSlice &slice, const Parameters &parameters, const Deadline *deadline,
                 ProcessGroup &group)
       : home_(slice.points), first_(slice.first), total_(slice.total), parameters_(parameters),
-        deadline_(deadline), group_(group), home_leaf_(home_.positions.size(), 0),
-        home_scale_(home_.positions.size(), 0.0f), home_pinch_(home_.positions.size(), 0) {
+        deadline_(deadline), group_(group), home_scale_(home_.positions.size(), 0.0f),
+        home_pinch_(home_.positions.size(), 0) {
     const std::vector<std::uint64_t> counts = countsOf(home_.positions.size(), group_);
     home_first_.assign(1, 0);
     for (std::uint64_t count : counts)
@@ -129,7 +108,7 @@ public:
   SharedSurface run() {
     buildTree();
     meshLeaves();
-    for (int depth = max_depth_; depth >= 0; --depth)
+    for (int depth = tree_.max_depth; depth >= 0; --depth)
       stitchLevel(depth);
     return finish();
   }
@@ -137,155 +116,19 @@ public:
 private:
   // ---- the tree ----------------------------------------------------------------
 
+  void buildTree() {
+    tree_ = buildSharedTree(home_.positions, first_, parameters_, group_);
+    statistics_.buckets = tree_.leaves.size();
+    for (const Node &node : tree_.nodes)
+      statistics_.seam_zones += node.axis >= 0;
+  }
+
   VertexIndex globalIndex(std::size_t home) const {
     return static_cast<VertexIndex>(first_ + home);
   }
 
-  /// The bounding box of all processes' `members`.
-  std::pair<Eigen::Vector3d, Eigen::Vector3d> boundsOf(const std::vector<std::uint32_t> &members) {
-    std::vector<double> low(3, std::numeric_limits<double>::infinity());
-    std::vector<double> high(3, -std::numeric_limits<double>::infinity());
-    for (std::uint32_t i : members)
-      for (int a = 0; a < 3; ++a) {
-        low[a] = std::min(low[a], home_.positions[i][a]);
-        high[a] = std::max(high[a], home_.positions[i][a]);
-      }
-    group_.minimum(low);
-    group_.maximum(high);
-    return {Eigen::Vector3d(low[0], low[1], low[2]), Eigen::Vector3d(high[0], high[1], high[2])};
-  }
-
-  /// The key of rank `rank` among all processes' members on `axis`: a radix
-  /// selection, 8 bits a round, 12 rounds (64-bit coordinate, 32-bit index).
-  SplitKey selectSplit(const std::vector<std::uint32_t> &members, int axis, std::uint64_t rank) {
-    std::vector<SplitKey> candidates;
-    candidates.reserve(members.size());
-    for (std::uint32_t i : members)
-      candidates.push_back({orderKey(home_.positions[i][axis]), globalIndex(i)});
-    SplitKey chosen{0, 0};
-    for (int round = 0; round < 12; ++round) {
-      auto digitOf = [&](const SplitKey &key) {
-        return round < 8 ? static_cast<unsigned>(key.coordinate >> (56 - 8 * round)) & 0xffu
-                         : static_cast<unsigned>(key.index >> (24 - 8 * (round - 8))) & 0xffu;
-      };
-      std::vector<std::uint64_t> histogram(256, 0);
-      for (const SplitKey &key : candidates)
-        ++histogram[digitOf(key)];
-      group_.sum(histogram);
-      unsigned digit = 0;
-      while (digit < 255 && histogram[digit] <= rank)
-        rank -= histogram[digit++];
-      if (round < 8)
-        chosen.coordinate |= static_cast<std::uint64_t>(digit) << (56 - 8 * round);
-      else
-        chosen.index |= static_cast<VertexIndex>(digit) << (24 - 8 * (round - 8));
-      candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
-                                      [&](const SplitKey &key) { return digitOf(key) != digit; }),
-                       candidates.end());
-    }
-    return chosen;
-  }
-
-  int makeLeaf(std::vector<std::uint32_t> &&members, const Box &region, int depth) {
-    Node node;
-    node.region = region;
-    node.depth = depth;
-    nodes_.push_back(node);
-    leaf_members_.push_back(std::move(members));
-    leaf_node_.push_back(static_cast<int>(nodes_.size() - 1));
-    return static_cast<int>(nodes_.size() - 1);
-  }
-
-  int makeInner(const Box &region, int axis, double split, int depth, int left, int right) {
-    return detail::addInner(nodes_, region, axis, split, depth, left, right);
-  }
-
-  /// As one process splits (buckets.cpp, BucketTree::buildMedian): at the
-  /// median of the longest side, ties by index.
-  int buildMedian(std::vector<std::uint32_t> &&members, const Box &region, int depth) {
-    const std::uint64_t count = totalOver(members.size(), group_);
-    if (count == 0)
-      return -1;
-    if (count <= bucket_points_)
-      return makeLeaf(std::move(members), region, depth);
-    const auto [low, high] = boundsOf(members);
-    int axis = 0;
-    (high - low).maxCoeff(&axis);
-    const SplitKey middle = selectSplit(members, axis, count / 2);
-    // The split is the middle point's own coordinate (its sign of zero too).
-    std::vector<double> split{std::numeric_limits<double>::infinity()};
-    std::vector<std::uint32_t> left_members, right_members;
-    for (std::uint32_t i : members) {
-      const SplitKey key{orderKey(home_.positions[i][axis]), globalIndex(i)};
-      if (key.index == middle.index && key.coordinate == middle.coordinate)
-        split[0] = home_.positions[i][axis];
-      (key < middle ? left_members : right_members).push_back(i);
-    }
-    std::vector<std::uint32_t>().swap(members);
-    group_.minimum(split);
-    Box left_region = region, right_region = region;
-    left_region.high[axis] = split[0];
-    right_region.low[axis] = split[0];
-    const int left = buildMedian(std::move(left_members), left_region, depth + 1);
-    const int right = buildMedian(std::move(right_members), right_region, depth + 1);
-    return makeInner(region, axis, split[0], depth, left, right);
-  }
-
-  /// As BucketTree::buildGrid: the grid's cell ranges halved, points on the
-  /// side of the plane their coordinate lies on.
-  int buildGrid(std::vector<std::uint32_t> &&members, const Box &region, std::array<int, 3> first,
-                std::array<int, 3> last, int depth) {
-    if (totalOver(members.size(), group_) == 0)
-      return -1;
-    const detail::GridHalves halves = detail::halveGrid(region, first, last, grid_low_, grid_cell_);
-    if (halves.leaf)
-      return makeLeaf(std::move(members), region, depth);
-    std::vector<std::uint32_t> left_members, right_members;
-    for (std::uint32_t i : members)
-      (home_.positions[i][halves.axis] < halves.split ? left_members : right_members).push_back(i);
-    std::vector<std::uint32_t>().swap(members);
-    const int left =
-        buildGrid(std::move(left_members), halves.left_region, first, halves.left_last, depth + 1);
-    const int right = buildGrid(std::move(right_members), halves.right_region, halves.right_first,
-                                last, depth + 1);
-    return makeInner(region, halves.axis, halves.split, depth, left, right);
-  }
-
-  void buildTree() {
-    std::vector<std::uint32_t> all(home_.positions.size());
-    for (std::size_t i = 0; i < all.size(); ++i)
-      all[i] = static_cast<std::uint32_t>(i);
-    const int grid = parameters_.grid_buckets;
-    if (grid > 0) {
-      const auto [low, high] = boundsOf(all);
-      grid_low_ = low;
-      grid_cell_ = ((high - low) / grid).cwiseMax(Eigen::Vector3d::Constant(1e-300));
-      root_ = buildGrid(std::move(all), Box(), {0, 0, 0}, {grid, grid, grid}, 0);
-    } else {
-      root_ = buildMedian(std::move(all), Box(), 0);
-    }
-    numberLeaves();
-    for (const Node &node : nodes_)
-      if (node.axis >= 0)
-        max_depth_ = std::max(max_depth_, node.depth);
-    statistics_.buckets = leaves_.size();
-    for (const Node &node : nodes_)
-      statistics_.seam_zones += node.axis >= 0;
-  }
-
-  /// Depth-first, as one process numbers them: a subtree's leaves form a range.
-  void numberLeaves() {
-    leaves_ = detail::numberLeaves(nodes_, root_);
-    for (std::size_t k = 0; k < leaf_node_.size(); ++k) {
-      const std::uint32_t leaf = nodes_[static_cast<std::size_t>(leaf_node_[k])].first_leaf;
-      for (std::uint32_t i : leaf_members_[k])
-        home_leaf_[i] = leaf;
-    }
-    std::vector<std::vector<std::uint32_t>>().swap(leaf_members_);
-  }
-
   int ownerOf(std::uint32_t leaf) const {
-    return bucketOwner(leaf, leaves_.size(), group_.processes());
+    return bucketOwner(leaf, tree_.leaves.size(), group_.processes());
   }
 
   int homeOf(VertexIndex index) const {
@@ -303,7 +146,7 @@ private:
         record.normal[a] = home_.normals[i][a];
     record.scale = home_scale_[i];
     record.index = globalIndex(i);
-    record.leaf = home_leaf_[i];
+    record.leaf = tree_.home_leaf[i];
     return record;
   }
 
@@ -329,11 +172,11 @@ private:
 
   /// Calls visit(leaf) for every leaf whose margin box holds p.
   template <typename Visit> void leavesReaching(const Eigen::Vector3d &p, const Visit &visit) {
-    std::vector<int> stack{root_};
+    std::vector<int> stack{tree_.root};
     while (!stack.empty()) {
       const int index = stack.back();
       stack.pop_back();
-      const Node &node = nodes_[static_cast<std::size_t>(index)];
+      const Node &node = tree_.nodes[static_cast<std::size_t>(index)];
       if (!node.region.expanded(subtree_margin_[static_cast<std::size_t>(index)]).contains(p))
         continue;
       if (node.axis < 0) {
@@ -348,7 +191,7 @@ private:
 
   /// Each bucket's spacing, as bucketSpacings in buckets.cpp.
   void measureMargins(const std::vector<std::vector<PointRecord>> &own) {
-    std::vector<double> spacings(leaves_.size(), 0.0);
+    std::vector<double> spacings(tree_.leaves.size(), 0.0);
     for (std::size_t k = 0; k < own.size(); ++k)
       spacings[own_leaves_[k]] =
           detail::medianSpacing(own[k].size(), detail::spacing_samples_per_bucket,
@@ -367,26 +210,26 @@ private:
             return Eigen::Vector3d(all[i][0], all[i][1], all[i][2]);
           });
     }
-    leaf_margin_.resize(leaves_.size());
-    for (std::size_t leaf = 0; leaf < leaves_.size(); ++leaf)
+    leaf_margin_.resize(tree_.leaves.size());
+    for (std::size_t leaf = 0; leaf < tree_.leaves.size(); ++leaf)
       leaf_margin_[leaf] =
           detail::bucketMargin(parameters_.rho, spacings[leaf] > 0 ? spacings[leaf] : fallback);
-    subtree_margin_.assign(nodes_.size(), 0.0);
-    for (std::size_t n = 0; n < nodes_.size(); ++n)
-      subtree_margin_[n] = *std::max_element(leaf_margin_.begin() + nodes_[n].first_leaf,
-                                             leaf_margin_.begin() + nodes_[n].end_leaf);
+    subtree_margin_.assign(tree_.nodes.size(), 0.0);
+    for (std::size_t n = 0; n < tree_.nodes.size(); ++n)
+      subtree_margin_[n] = *std::max_element(leaf_margin_.begin() + tree_.nodes[n].first_leaf,
+                                             leaf_margin_.begin() + tree_.nodes[n].end_leaf);
   }
 
   void meshLeaves() {
     const Clock::time_point stage = Clock::now();
-    for (std::uint32_t leaf = 0; leaf < leaves_.size(); ++leaf)
+    for (std::uint32_t leaf = 0; leaf < tree_.leaves.size(); ++leaf)
       if (ownerOf(leaf) == group_.process())
         own_leaves_.push_back(leaf);
     // Every point to the owner of its bucket.
     const auto processes = static_cast<std::size_t>(group_.processes());
     std::vector<std::vector<PointRecord>> outgoing(processes);
     for (std::size_t i = 0; i < home_.positions.size(); ++i)
-      outgoing[static_cast<std::size_t>(ownerOf(home_leaf_[i]))].push_back(homeRecord(i));
+      outgoing[static_cast<std::size_t>(ownerOf(tree_.home_leaf[i]))].push_back(homeRecord(i));
     std::vector<std::vector<PointRecord>> own(own_leaves_.size());
     deliver(outgoing, group_,
             [&](const PointRecord &record) { own[ownSlot(record.leaf)].push_back(record); });
@@ -398,7 +241,7 @@ private:
     std::vector<std::vector<PointFor>> margins(processes);
     for (std::size_t i = 0; i < home_.positions.size(); ++i)
       leavesReaching(home_.positions[i], [&](std::uint32_t leaf) {
-        if (leaf != home_leaf_[i])
+        if (leaf != tree_.home_leaf[i])
           margins[static_cast<std::size_t>(ownerOf(leaf))].push_back({homeRecord(i), leaf});
       });
     std::vector<std::vector<PointRecord>> members = std::move(own);
@@ -464,8 +307,8 @@ private:
     deliver(pinches, group_, [&](const IndexFor &pinch) { home_pinch_[pinch.index - first_] = 1; });
 
     // The buckets' figures: only the owner's entry is non-zero.
-    std::vector<double> d_med(leaves_.size(), 0.0), failed(leaves_.size(), 0.0),
-        margin(leaves_.size(), 0.0);
+    std::vector<double> d_med(tree_.leaves.size(), 0.0), failed(tree_.leaves.size(), 0.0),
+        margin(tree_.leaves.size(), 0.0);
     std::uint32_t first_failure = std::numeric_limits<std::uint32_t>::max();
     std::string first_error;
     for (std::size_t k = 0; k < own_leaves_.size(); ++k) {
@@ -483,7 +326,7 @@ private:
     group_.maximum(failed);
     group_.maximum(margin);
     std::vector<double> bucket_d_meds;
-    for (std::size_t leaf = 0; leaf < leaves_.size(); ++leaf) {
+    for (std::size_t leaf = 0; leaf < tree_.leaves.size(); ++leaf) {
       statistics_.margin_points += static_cast<std::size_t>(margin[leaf]);
       if (failed[leaf] == 0.0)
         bucket_d_meds.push_back(d_med[leaf]);
@@ -526,7 +369,7 @@ private:
 
   std::size_t ownZones() const {
     std::size_t zones = 0;
-    for (const Node &node : nodes_)
+    for (const Node &node : tree_.nodes)
       zones += node.axis >= 0 && ownerOf(node.first_leaf) == group_.process();
     return zones;
   }
@@ -566,26 +409,26 @@ private:
 
   void stitchLevel(int depth) {
     const Clock::time_point stage = Clock::now();
-    if (depth == max_depth_) {
+    if (depth == tree_.max_depth) {
       // The buckets' triangles become their leaves' sets.
       for (std::size_t k = 0; k < own_leaves_.size(); ++k)
-        node_triangles_[leaves_[own_leaves_[k]]] = std::move(leaf_triangles_[k]);
+        node_triangles_[tree_.leaves[own_leaves_[k]]] = std::move(leaf_triangles_[k]);
       std::vector<std::vector<Triangle>>().swap(leaf_triangles_);
     }
     std::vector<int> level;
-    for (std::size_t n = 0; n < nodes_.size(); ++n)
-      if (nodes_[n].axis >= 0 && nodes_[n].depth == depth)
+    for (std::size_t n = 0; n < tree_.nodes.size(); ++n)
+      if (tree_.nodes[n].axis >= 0 && tree_.nodes[n].depth == depth)
         level.push_back(static_cast<int>(n));
     const auto processes = static_cast<std::size_t>(group_.processes());
     const int me = group_.process();
     auto zoneOwner = [&](int node) {
-      return ownerOf(nodes_[static_cast<std::size_t>(node)].first_leaf);
+      return ownerOf(tree_.nodes[static_cast<std::size_t>(node)].first_leaf);
     };
 
     // The largest local scale near each plane, from every home.
     std::vector<double> margin(level.size()), largest(level.size(), 0.0);
     for (std::size_t z = 0; z < level.size(); ++z) {
-      const Node &node = nodes_[static_cast<std::size_t>(level[z])];
+      const Node &node = tree_.nodes[static_cast<std::size_t>(level[z])];
       margin[z] = subtree_margin_[static_cast<std::size_t>(level[z])];
       const Box slab = detail::zoneSlab(node.region, node.axis, node.split, margin[z], margin[z]);
       float scale = 0;
@@ -597,7 +440,7 @@ private:
     // Each zone's points, from their homes, to its owner.
     std::vector<std::vector<PointFor>> outgoing(processes);
     for (std::size_t z = 0; z < level.size(); ++z) {
-      const Node &node = nodes_[static_cast<std::size_t>(level[z])];
+      const Node &node = tree_.nodes[static_cast<std::size_t>(level[z])];
       const double half_width = parameters_.rho * static_cast<float>(largest[z]);
       const Box slab = detail::zoneSlab(node.region, node.axis, node.split, margin[z], half_width);
       forEachHomeIn(slab, [&](std::size_t i) {
@@ -612,7 +455,7 @@ private:
     // Each zone's second subtree's triangles to the zone's owner.
     std::vector<std::vector<TriangleFor>> moving(processes);
     for (int node : level) {
-      const int second = nodes_[static_cast<std::size_t>(node)].children[1];
+      const int second = tree_.nodes[static_cast<std::size_t>(node)].children[1];
       if (zoneOwner(second) == me && zoneOwner(node) != me) {
         for (const Triangle &triangle : trianglesOf(second))
           moving[static_cast<std::size_t>(zoneOwner(node))].push_back(
@@ -640,7 +483,7 @@ private:
         return std::binary_search(zone_indices[z].begin(), zone_indices[z].end(), v);
       };
       std::vector<VertexIndex> frozen;
-      for (int child : nodes_[static_cast<std::size_t>(level[z])].children)
+      for (int child : tree_.nodes[static_cast<std::size_t>(level[z])].children)
         for (const Triangle &triangle : trianglesOf(child)) {
           if (!(inZone(triangle[0]) || inZone(triangle[1]) || inZone(triangle[2])))
             continue;
@@ -722,7 +565,7 @@ private:
       seam_figures_[1] += static_cast<double>(outcome.triangles.size());
       // The subtree's triangles, then the seam's, in a fixed order.
       std::vector<Triangle> &merged = trianglesOf(node);
-      const int *children = nodes_[static_cast<std::size_t>(node)].children;
+      const int *children = tree_.nodes[static_cast<std::size_t>(node)].children;
       merged.reserve(trianglesOf(children[0]).size() + trianglesOf(children[1]).size() +
                      added.size());
       for (int c = 0; c < 2; ++c) {
@@ -746,7 +589,7 @@ private:
                        std::vector<PointRecord> &frozen, const std::vector<Triangle> &fixed,
                        std::vector<PointRecord> &members, std::vector<bool> &core,
                        std::size_t &core_points) const {
-    const Node &node = nodes_[static_cast<std::size_t>(node_index)];
+    const Node &node = tree_.nodes[static_cast<std::size_t>(node_index)];
     auto inSubtree = [&](const PointRecord &point) {
       return point.leaf >= node.first_leaf && point.leaf < node.end_leaf;
     };
@@ -834,7 +677,7 @@ private:
         group_);
     if (group_.process() != 0)
       return shared;
-    surface.triangles = std::move(trianglesOf(root_));
+    surface.triangles = std::move(trianglesOf(tree_.root));
     surface.statistics.bow_tie_triangles_removed =
         splitBowTies(surface.triangles, total_, may_pinch);
     return shared;
@@ -845,19 +688,11 @@ private:
   const Parameters &parameters_;
   const Deadline *deadline_;
   ProcessGroup &group_;
-  const std::size_t bucket_points_ =
-      parameters_.bucket_points > 0 ? parameters_.bucket_points : default_bucket_points;
   std::vector<std::uint64_t> home_first_; // process p's home points start at home_first_[p]
-  std::vector<std::uint32_t> home_leaf_;
   std::vector<float> home_scale_;
   std::vector<std::uint8_t> home_pinch_;
 
-  std::vector<Node> nodes_;
-  std::vector<int> leaves_;    // node of each leaf number
-  std::vector<int> leaf_node_; // while building: node of each leaf made
-  std::vector<std::vector<std::uint32_t>> leaf_members_;
-  int root_ = -1, max_depth_ = 0;
-  Eigen::Vector3d grid_low_ = Eigen::Vector3d::Zero(), grid_cell_ = Eigen::Vector3d::Ones();
+  SharedTree tree_;
   std::vector<double> leaf_margin_, subtree_margin_;
   std::vector<Box> run_boxes_; // of runs of home points (forEachHomeIn)
 
