@@ -56,30 +56,34 @@ struct Selection {
   std::uint64_t rank = 0;
 };
 
-/// The selected values, exact, in two rounds of 2^16-bin histograms of the
-/// values' order keys (high half, then low half within the chosen bin).
+/// The selected values, exact: a radix selection on the values' order keys,
+/// a byte a round (4 rounds of 256-bin histograms summed over the
+/// processes), each round among the values whose higher bytes match the
+/// bytes chosen so far.
 /// `excluded` (may be empty) leaves points out.
 std::vector<double> selectTogether(const std::vector<Eigen::Vector3f> &points,
                                    const std::vector<bool> &excluded,
                                    const std::vector<Selection> &selections, ProcessGroup &group) {
-  constexpr std::size_t bins = 1 << 16;
+  // Small histograms: a tiny cloud pays for what it sends, not for bins.
+  constexpr int digit_bits = 8, rounds = 32 / digit_bits;
+  constexpr std::size_t bins = std::size_t{1} << digit_bits;
   const std::size_t count = selections.size();
-  std::vector<std::uint32_t> high_bin(count, 0);
   std::vector<std::uint64_t> remaining(count);
   for (std::size_t q = 0; q < count; ++q)
     remaining[q] = selections[q].rank;
-  std::vector<std::uint32_t> key(count, 0);
-  for (int round = 0; round < 2; ++round) {
+  std::vector<std::uint32_t> key(count, 0); // the digits chosen so far
+  for (int round = 0; round < rounds; ++round) {
+    const int shift = 32 - digit_bits * (round + 1);
+    // The digits above this round's, to match in the key chosen so far.
+    const std::uint32_t chosen_mask = round == 0 ? 0u : ~std::uint32_t{0} << (shift + digit_bits);
     std::vector<std::uint64_t> histogram(count * bins, 0);
     for (std::size_t i = 0; i < points.size(); ++i) {
       if (!excluded.empty() && excluded[i])
         continue;
       for (std::size_t q = 0; q < count; ++q) {
         const std::uint32_t k = orderKey(points[i][selections[q].axis]);
-        if (round == 0)
-          ++histogram[q * bins + (k >> 16)];
-        else if ((k >> 16) == high_bin[q])
-          ++histogram[q * bins + (k & 0xffffu)];
+        if ((k & chosen_mask) == key[q])
+          ++histogram[q * bins + ((k >> shift) & (bins - 1))];
       }
     }
     group.sum(histogram);
@@ -87,10 +91,7 @@ std::vector<double> selectTogether(const std::vector<Eigen::Vector3f> &points,
       std::size_t bin = 0;
       while (bin + 1 < bins && histogram[q * bins + bin] <= remaining[q])
         remaining[q] -= histogram[q * bins + bin++];
-      if (round == 0)
-        high_bin[q] = static_cast<std::uint32_t>(bin);
-      else
-        key[q] = high_bin[q] << 16 | static_cast<std::uint32_t>(bin);
+      key[q] |= static_cast<std::uint32_t>(bin) << shift;
     }
   }
   std::vector<double> values(count);
