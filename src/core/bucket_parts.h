@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include <pcl_ms/reconstruct.h>
 #include <pcl_ms/types.h>
 
 #include <algorithm>
@@ -16,6 +17,7 @@
 #include <functional>
 #include <limits>
 #include <mutex>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -158,6 +160,21 @@ inline GridHalves halveGrid(const Box &region, const std::array<int, 3> &first,
   halves.left_last[axis] = middle_cell;
   halves.right_first[axis] = middle_cell;
   return halves;
+}
+
+/// The cloud's d_med: the median of the meshed buckets' (not empty).
+inline double medianBucketDMed(std::vector<double> d_meds) {
+  std::nth_element(d_meds.begin(), d_meds.begin() + d_meds.size() / 2, d_meds.end());
+  return d_meds[d_meds.size() / 2];
+}
+
+/// When no bucket could be meshed: the first bucket's error, with a hint
+/// when a few points in a fine grid left each margin without neighbours.
+[[noreturn]] inline void throwNoBucketMeshed(std::string first_error) {
+  if (first_error == too_few_unit_points)
+    first_error += " with its margin (too many buckets for the cloud: use fewer or none)";
+  throw ReconstructionError("no bucket could be meshed" +
+                            (first_error.empty() ? std::string() : ": " + first_error));
 }
 
 /// Calls Parameters::progress one unit at a time, from whichever thread

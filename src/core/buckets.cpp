@@ -299,16 +299,9 @@ public:
       else
         ++surface_.statistics.failed_units;
     }
-    if (bucket_d_meds.empty()) {
-      // A few points in a fine grid: margins of the spacing reach no others.
-      if (first_error == detail::too_few_unit_points)
-        first_error += " with its margin (too many buckets for the cloud: use fewer or none)";
-      throw ReconstructionError("no bucket could be meshed" +
-                                (first_error.empty() ? std::string() : ": " + first_error));
-    }
-    std::nth_element(bucket_d_meds.begin(), bucket_d_meds.begin() + bucket_d_meds.size() / 2,
-                     bucket_d_meds.end());
-    surface_.d_med = bucket_d_meds[bucket_d_meds.size() / 2];
+    if (bucket_d_meds.empty())
+      detail::throwNoBucketMeshed(first_error);
+    surface_.d_med = detail::medianBucketDMed(std::move(bucket_d_meds));
     surface_.statistics.buckets_seconds = secondsSince(stage);
     exchange_.stageDone("buckets");
 

@@ -341,15 +341,9 @@ private:
       if (first_failure == static_cast<std::uint32_t>(first[0]))
         mine.assign(first_error.begin(), first_error.end());
       const std::vector<unsigned char> all = group_.gatherAll(mine);
-      std::string error(all.begin(), all.end());
-      if (error == detail::too_few_unit_points)
-        error += " with its margin (too many buckets for the cloud: use fewer or none)";
-      throw ReconstructionError("no bucket could be meshed" +
-                                (error.empty() ? std::string() : ": " + error));
+      detail::throwNoBucketMeshed(std::string(all.begin(), all.end()));
     }
-    std::nth_element(bucket_d_meds.begin(), bucket_d_meds.begin() + bucket_d_meds.size() / 2,
-                     bucket_d_meds.end());
-    d_med_ = bucket_d_meds[bucket_d_meds.size() / 2];
+    d_med_ = detail::medianBucketDMed(std::move(bucket_d_meds));
     statistics_.buckets_seconds = secondsSince(stage);
   }
 
