@@ -236,8 +236,9 @@ struct Result {
 
   std::size_t candidates_type1 = 0, candidates_type2 = 0, candidates_type3 = 0;
   std::size_t candidates_oversize = 0;
-  /// Delaunay triangles whose corners are collinear (left out). Exact
-  /// predicates should keep this 0; it is counted so that a breach shows.
+  /// Delaunay triangles whose corners are collinear, or so unevenly far
+  /// apart that their circumcircle does not exist in double precision
+  /// (left out). Exact predicates keep the collinear ones at 0.
   std::size_t candidates_degenerate = 0;
   /// Summaries: the median Gabriel circumradius and rho times it. The size
   /// limit itself is local (Parameters::rho).

@@ -356,6 +356,13 @@ private:
                     return;
                   }
                   const Circle circle = circumcircle(p, edges, false);
+                  if (!std::isfinite(circle.radius)) {
+                    // Not collinear, but too thin for its circle to exist in
+                    // double precision (|u x v|^2 under- or overflows): as
+                    // degenerate as a collinear facet, and left out alike.
+                    kinds.push_back(FacetKind::collinear);
+                    return;
+                  }
                   // 4 sqrt(3) A / (d1^2 + d2^2 + d3^2), A = |w| / 2.
                   const double compactness =
                       2 * std::sqrt(3.0) * std::sqrt(edges.ww) /
@@ -562,6 +569,10 @@ private:
                   const bool needs_circle = (gabriel && !scaffold_.planar) || options_.normals;
                   const Circle circle =
                       needs_circle ? circumcircle(a, EdgeVectors(a, b, c)) : Circle{};
+                  if (!std::isfinite(circle.radius)) { // from other corners than above
+                    ++out.degenerate;
+                    return;
+                  }
                   double shock_length;
                   if (scaffold_.planar) {
                     // Both Voronoi pieces are infinite in a plane: rank by shape and size.

@@ -272,6 +272,29 @@ TEST(Scaffold, PlanarGridGivesTwoDimensionalDelaunay) {
   EXPECT_NEAR(scaffold.d_med, std::sqrt(0.5), 1e-6);
 }
 
+TEST(Scaffold, FacetsTooThinForDoublesAreLeftOutNotNaN) {
+  // A tiny tetrahedron and two far corners: a facet with one far corner and
+  // two tiny ones is not collinear (exact predicates), but its edge vectors
+  // are equal in double, so its circle would be 0 / 0. Such facets are left
+  // out as degenerate. Their NaN radii made d_med and the local scales NaN,
+  // and a cloud cut among processes then met one process's mesh otherwise.
+  const double tiny = 1e-12;
+  const std::vector<Eigen::Vector3d> points = {{0, 0, 0},
+                                               {tiny, 0, 0},
+                                               {0.3 * tiny, 0.9 * tiny, 0},
+                                               {0.4 * tiny, 0.3 * tiny, 0.8 * tiny},
+                                               {-1e31, 4e30, 2e30},
+                                               {1e31, 2e30, -3e30}};
+  const MedialScaffold scaffold = buildMedialScaffold(points, {});
+  EXPECT_TRUE(std::isfinite(scaffold.d_med) && scaffold.d_med > 0) << scaffold.d_med;
+  for (float scale : scaffold.local_scale)
+    EXPECT_FALSE(std::isnan(scale));
+  for (const Candidate &candidate : scaffold.candidates) {
+    EXPECT_FALSE(std::isnan(candidate.base_cost));
+    EXPECT_FALSE(std::isnan(candidate.inverse_shock_compactness));
+  }
+}
+
 TEST(Scaffold, CollinearPointsAreRejected) {
   const std::vector<Eigen::Vector3d> line = {{0, 0, 0}, {1, 1, 1}, {2, 2, 2}, {3, 3, 3}};
   EXPECT_THROW(buildMedialScaffold(line, {}), ReconstructionError);
