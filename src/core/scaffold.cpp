@@ -357,9 +357,9 @@ private:
                   }
                   const Circle circle = circumcircle(p, edges, false);
                   if (!std::isfinite(circle.radius)) {
-                    // Not collinear, but too thin for its circle to exist in
-                    // double precision (|u x v|^2 under- or overflows): as
-                    // degenerate as a collinear facet, and left out alike.
+                    // Not collinear, but its circle does not exist in double
+                    // precision (edge vectors that round to parallel ones, or
+                    // |u x v|^2 out of range): left out like a collinear one.
                     kinds.push_back(FacetKind::collinear);
                     return;
                   }

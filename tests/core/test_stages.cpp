@@ -277,7 +277,7 @@ TEST(Scaffold, FacetsTooThinForDoublesAreLeftOutNotNaN) {
   // two tiny ones is not collinear (exact predicates), but its edge vectors
   // are equal in double, so its circle would be 0 / 0. Such facets are left
   // out as degenerate. Their NaN radii made d_med and the local scales NaN,
-  // and a cloud cut among processes then met one process's mesh otherwise.
+  // and processes sharing such a cloud then meshed it otherwise than one.
   const double tiny = 1e-12;
   const std::vector<Eigen::Vector3d> points = {{0, 0, 0},
                                                {tiny, 0, 0},
