@@ -293,6 +293,19 @@ TEST(Scaffold, FacetsTooThinForDoublesAreLeftOutNotNaN) {
     EXPECT_FALSE(std::isnan(candidate.base_cost));
     EXPECT_FALSE(std::isnan(candidate.inverse_shock_compactness));
   }
+  // The candidate pass computes the circle again from the lowest-numbered
+  // corner: the far ones first, and a size limit that keeps such facets,
+  // make that circle 0 / 0 where the first pass's was finite.
+  std::vector<Eigen::Vector3d> far_first(points.end() - 2, points.end());
+  far_first.insert(far_first.end(), points.begin(), points.end() - 2);
+  ScaffoldOptions no_size_limit;
+  no_size_limit.rho = 1e60;
+  const MedialScaffold far_first_scaffold = buildMedialScaffold(far_first, no_size_limit);
+  EXPECT_GT(far_first_scaffold.degenerate, 0u);
+  for (const Candidate &candidate : far_first_scaffold.candidates) {
+    EXPECT_FALSE(std::isnan(candidate.base_cost));
+    EXPECT_FALSE(std::isnan(candidate.inverse_shock_compactness));
+  }
 }
 
 TEST(Scaffold, CollinearPointsAreRejected) {
