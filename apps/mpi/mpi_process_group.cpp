@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// MpiProcessGroup: reductions with MPI_Allreduce; byte exchanges pairwise,
-// in pieces below MPI's int counts, so that a rank may send more than 2 GB.
+// MpiProcessGroup: reductions with MPI_Allreduce (minimum and maximum with
+// operations of our own, which give any order of ranks the same bits); byte
+// exchanges pairwise, in pieces below MPI's int counts, so that a rank may
+// send more than 2 GB.
 // A rank that reaches a collective before the others waits for them asleep:
 // Open MPI's blocking calls spin a core, which the ranks still meshing need
 // when there are more ranks than cores.
@@ -29,6 +31,29 @@ void waitAsleep(std::vector<MPI_Request> &requests) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
 }
+
+/// MPI_Op functions over MPI_DOUBLE: MPI_MIN and MPI_MAX leave NaN and
+/// signed zeros to the order in which Open MPI meets the ranks' values.
+template <double (*combine)(double, double)>
+void combineDoubles(void *in, void *in_out, int *count, MPI_Datatype *) {
+  const double *theirs = static_cast<const double *>(in);
+  double *ours = static_cast<double *>(in_out);
+  for (int i = 0; i < *count; ++i)
+    ours[i] = combine(theirs[i], ours[i]);
+}
+
+/// An MPI_Op over a function, freed when it goes out of scope.
+class CommutativeOp {
+public:
+  explicit CommutativeOp(MPI_User_function *function) { MPI_Op_create(function, 1, &op_); }
+  ~CommutativeOp() { MPI_Op_free(&op_); }
+  CommutativeOp(const CommutativeOp &) = delete;
+  CommutativeOp &operator=(const CommutativeOp &) = delete;
+  MPI_Op get() const { return op_; }
+
+private:
+  MPI_Op op_ = MPI_OP_NULL;
+};
 
 } // namespace
 
@@ -59,11 +84,13 @@ void MpiProcessGroup::sum(std::vector<std::uint64_t> &values) {
 }
 
 void MpiProcessGroup::minimum(std::vector<double> &values) {
-  reduce(values.data(), values.size(), MPI_DOUBLE, MPI_MIN);
+  const CommutativeOp minimum(&combineDoubles<pcl_ms::orderFreeMinimum>);
+  reduce(values.data(), values.size(), MPI_DOUBLE, minimum.get());
 }
 
 void MpiProcessGroup::maximum(std::vector<double> &values) {
-  reduce(values.data(), values.size(), MPI_DOUBLE, MPI_MAX);
+  const CommutativeOp maximum(&combineDoubles<pcl_ms::orderFreeMaximum>);
+  reduce(values.data(), values.size(), MPI_DOUBLE, maximum.get());
 }
 
 std::vector<unsigned char> MpiProcessGroup::gatherAll(const std::vector<unsigned char> &mine) {

@@ -55,12 +55,8 @@ public:
   void sum(std::vector<std::uint64_t> &values) override {
     combine(values, [](std::uint64_t a, std::uint64_t b) { return a + b; });
   }
-  void minimum(std::vector<double> &values) override {
-    combine(values, [](double a, double b) { return std::min(a, b); });
-  }
-  void maximum(std::vector<double> &values) override {
-    combine(values, [](double a, double b) { return std::max(a, b); });
-  }
+  void minimum(std::vector<double> &values) override { combine(values, pcl_ms::orderFreeMinimum); }
+  void maximum(std::vector<double> &values) override { combine(values, pcl_ms::orderFreeMaximum); }
   std::vector<unsigned char> gatherAll(const std::vector<unsigned char> &mine) override {
     std::vector<unsigned char> all;
     share(&mine, [&](int, const void *theirs) {

@@ -5,10 +5,32 @@
 // all processes make it, in the same order.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace pcl_ms {
+
+/// The element-wise combinations of minimum() and maximum(), for every
+/// implementation. Each gives the same bits whatever order the processes'
+/// values meet in: NaN wins, as one quiet NaN (std::max and MPI_MAX let the
+/// order decide, so processes would disagree with one process's run); of
+/// equal zeros, -0 is the smaller.
+inline double orderFreeMinimum(double a, double b) {
+  if (std::isnan(a) || std::isnan(b))
+    return std::numeric_limits<double>::quiet_NaN();
+  if (a == b)
+    return std::signbit(a) ? a : b;
+  return a < b ? a : b;
+}
+inline double orderFreeMaximum(double a, double b) {
+  if (std::isnan(a) || std::isnan(b))
+    return std::numeric_limits<double>::quiet_NaN();
+  if (a == b)
+    return std::signbit(a) ? b : a;
+  return a > b ? a : b;
+}
 
 class ProcessGroup {
 public:
@@ -17,6 +39,7 @@ public:
   virtual int process() const = 0;
   /// Element-wise over all processes; every process gets the result.
   virtual void sum(std::vector<std::uint64_t> &values) = 0;
+  /// With orderFreeMinimum and orderFreeMaximum.
   virtual void minimum(std::vector<double> &values) = 0;
   virtual void maximum(std::vector<double> &values) = 0;
   /// Every process's bytes, concatenated in process order, on every process.
