@@ -19,6 +19,7 @@
 #include <iterator>
 #include <limits>
 #include <numeric>
+#include <optional>
 
 namespace pcl_ms {
 namespace {
@@ -77,9 +78,9 @@ bool isGabriel(const Delaunay &delaunay, CellHandle cell, int i,
 }
 
 struct Circle {
-  Eigen::Vector3d centre;
-  Eigen::Vector3d unit_normal;
-  double radius;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d unit_normal = Eigen::Vector3d::Zero();
+  double radius = 0;
 };
 
 // Below this compactness the floating-point circumcentre may be off by more
@@ -127,13 +128,19 @@ struct EdgeVectors {
 
 /// The circumcircle of the triangle with corner a and edge vectors `edges`;
 /// its unit normal only if asked for (the local scales, which see every
-/// facet, need centre and radius only).
-Circle circumcircle(const Eigen::Vector3d &a, const EdgeVectors &edges, bool with_normal = true) {
-  Circle circle{};
+/// facet, need centre and radius only). None where it does not exist in
+/// double precision, though the corners are not collinear: edge vectors that
+/// round to parallel ones (a far corner beside two close ones), or
+/// |u x v|^2 out of range. Callers leave such a facet out as degenerate.
+std::optional<Circle> circumcircle(const Eigen::Vector3d &a, const EdgeVectors &edges,
+                                   bool with_normal = true) {
+  Circle circle;
   const Eigen::Vector3d offset =
       (edges.uu * edges.v.cross(edges.w) + edges.vv * edges.w.cross(edges.u)) / (2.0 * edges.ww);
   circle.centre = a + offset;
   circle.radius = offset.norm();
+  if (!std::isfinite(circle.radius))
+    return std::nullopt;
   if (with_normal)
     circle.unit_normal = edges.w / std::sqrt(edges.ww);
   return circle;
@@ -355,14 +362,12 @@ private:
                     kinds.push_back(FacetKind::collinear);
                     return;
                   }
-                  const Circle circle = circumcircle(p, edges, false);
-                  if (!std::isfinite(circle.radius)) {
-                    // Not collinear, but its circle does not exist in double
-                    // precision (edge vectors that round to parallel ones, or
-                    // |u x v|^2 out of range): left out like a collinear one.
+                  const std::optional<Circle> found = circumcircle(p, edges, false);
+                  if (!found) { // left out like a collinear facet
                     kinds.push_back(FacetKind::collinear);
                     return;
                   }
+                  const Circle &circle = *found;
                   // 4 sqrt(3) A / (d1^2 + d2^2 + d3^2), A = |w| / 2.
                   const double compactness =
                       2 * std::sqrt(3.0) * std::sqrt(edges.ww) /
@@ -567,12 +572,15 @@ private:
                   // Types I and II measure their shock from the circle;
                   // type III needs it only for the normal term.
                   const bool needs_circle = (gabriel && !scaffold_.planar) || options_.normals;
-                  const Circle circle =
+                  // From other corners than the local scales' pass: it may
+                  // be missing where that one's was found.
+                  const std::optional<Circle> found =
                       needs_circle ? circumcircle(a, EdgeVectors(a, b, c)) : Circle{};
-                  if (!std::isfinite(circle.radius)) { // from other corners than above
+                  if (!found) {
                     ++out.degenerate;
                     return;
                   }
+                  const Circle &circle = *found;
                   double shock_length;
                   if (scaffold_.planar) {
                     // Both Voronoi pieces are infinite in a plane: rank by shape and size.
