@@ -2,7 +2,7 @@
 // Run under mpirun: every rank must get the same bits from MpiProcessGroup's
 // minimum and maximum, with a NaN on any one rank and zeros of both signs,
 // as tests/core/test_process_group.cpp asks of the functions themselves.
-// Exits non-zero on the first rank that sees otherwise.
+// A rank that sees otherwise says so and exits non-zero.
 #include "mpi_process_group.h"
 
 #include <cmath>
