@@ -6,13 +6,13 @@
 
 #include <pcl_ms/process_group.h>
 
-#include <algorithm>
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
 #include <mutex>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace pcl_ms_test {
