@@ -73,7 +73,8 @@ std::vector<std::vector<std::uint32_t>> fansAt(VertexIndex v,
 } // namespace
 
 void dropTriangles(std::vector<Triangle> &triangles, const std::vector<bool> &drop,
-                   std::vector<bool> &touched) {
+                   std::vector<bool> &touched, MeshEdges *edges) {
+  const bool scan_again = edges && !dropFromMeshEdges(*edges, triangles, drop);
   std::size_t write = 0;
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     if (drop[t])
@@ -83,12 +84,15 @@ void dropTriangles(std::vector<Triangle> &triangles, const std::vector<bool> &dr
       triangles[write++] = triangles[t];
   }
   triangles.resize(write);
+  if (scan_again) {
+    *edges = MeshEdges(); // not held while the new ones are made
+    *edges = meshEdges(triangles, true);
+  }
 }
 
-} // namespace detail
-
 std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_count,
-                         std::vector<bool> &touched, const std::vector<Triangle> *fixed) {
+                         std::vector<bool> &touched, const std::vector<Triangle> *fixed,
+                         MeshEdges *edges) {
   const std::size_t before = triangles.size();
   const auto isFixed = [&](std::uint32_t t) {
     if (!fixed)
@@ -103,17 +107,17 @@ std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_co
   std::vector<bool> check = touched;
   for (bool changed = true; changed;) {
     changed = false;
-    const detail::MarkedIncidence incidence(triangles, check);
+    const MarkedIncidence incidence(triangles, check);
     std::vector<bool> drop(triangles.size(), false);
     for (std::size_t slot = 0; slot < incidence.vertices().size(); ++slot) {
       const VertexIndex v = incidence.vertices()[slot];
       if (incidence.atSlot(slot).size() < 2)
         continue;
-      const auto fans = detail::fansAt(v, incidence.atSlot(slot), triangles);
+      const auto fans = fansAt(v, incidence.atSlot(slot), triangles);
       if (fans.size() < 2)
         continue;
-      const std::size_t keep = detail::fanToKeep(fans.size(), [&](std::size_t f) {
-        detail::FanWeight weight;
+      const std::size_t keep = fanToKeep(fans.size(), [&](std::size_t f) {
+        FanWeight weight;
         weight.fixed =
             static_cast<std::size_t>(std::count_if(fans[f].begin(), fans[f].end(), isFixed));
         weight.size = fans[f].size();
@@ -127,13 +131,20 @@ std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_co
     }
     if (changed) {
       std::fill(check.begin(), check.end(), false);
-      detail::dropTriangles(triangles, drop, check);
+      dropTriangles(triangles, drop, check, edges);
       for (VertexIndex v = 0; v < check.size(); ++v)
         if (check[v])
           touched[v] = true;
     }
   }
   return before - triangles.size();
+}
+
+} // namespace detail
+
+std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_count,
+                         std::vector<bool> &touched, const std::vector<Triangle> *fixed) {
+  return detail::splitBowTies(triangles, vertex_count, touched, fixed, nullptr);
 }
 
 } // namespace pcl_ms

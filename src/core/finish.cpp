@@ -234,6 +234,106 @@ void addFilling(MeshEdges &edges, const std::vector<Triangle> &triangles, std::s
   edges.boundary_triangle = std::move(boundary_triangle);
 }
 
+bool dropFromMeshEdges(MeshEdges &edges, const std::vector<Triangle> &triangles,
+                       const std::vector<bool> &drop) {
+  // Every incidence is a boundary edge's or one of a manifold pair's, unless
+  // some edge has three triangles or more.
+  const std::size_t count = triangles.size();
+  const std::size_t paired = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, 3 * count, 1 << 14), std::size_t{0},
+      [&](const tbb::blocked_range<std::size_t> &range, std::size_t found) {
+        for (std::size_t slot = range.begin(); slot != range.end(); ++slot)
+          found += edges.neighbours[slot] != no_neighbour;
+        return found;
+      },
+      [](std::size_t a, std::size_t b) { return a + b; });
+  if (paired + edges.boundary.size() != 3 * count)
+    return false;
+  std::vector<std::uint32_t> dropped;
+  for (std::uint32_t t = 0; t < count; ++t)
+    if (drop[t])
+      dropped.push_back(t);
+  if (dropped.empty())
+    return true;
+
+  // A kept neighbour's shared edge opens; a dropped triangle's own boundary
+  // edges go. The kept neighbour's slots stay in key order without it.
+  std::vector<std::pair<EdgeKey, std::uint32_t>> opened;
+  std::vector<EdgeKey> gone;
+  for (std::uint32_t t : dropped) {
+    std::array<EdgeKey, 3> own;
+    for (int k = 0; k < 3; ++k)
+      own[static_cast<std::size_t>(k)] = edgeKey(triangles[t][k], triangles[t][(k + 1) % 3]);
+    std::array<bool, 3> shared = {false, false, false};
+    const std::uint32_t *slots = &edges.neighbours[3 * std::size_t{t}];
+    for (std::size_t k = 0; k < 3 && slots[k] != no_neighbour; ++k) {
+      const std::uint32_t u = slots[k];
+      const EdgeKey key = sharedEdge(triangles[t], triangles[u]);
+      for (std::size_t i = 0; i < 3; ++i)
+        shared[i] = shared[i] || own[i] == key;
+      if (drop[u])
+        continue; // the edge goes with both
+      opened.emplace_back(key, u);
+      std::uint32_t *at = &edges.neighbours[3 * std::size_t{u}];
+      std::uint32_t *end = std::remove(at, at + 3, t);
+      std::fill(end, at + 3, no_neighbour);
+    }
+    for (std::size_t i = 0; i < 3; ++i)
+      if (!shared[i])
+        gone.push_back(own[i]);
+  }
+
+  // New numbers: each kept triangle moves down by the dropped ones before it.
+  std::vector<std::uint32_t> renumbered(count);
+  for (std::uint32_t t = 0, next = 0; t < count; ++t)
+    renumbered[t] = drop[t] ? no_neighbour : next++;
+  forEachIndex(count, [&](std::size_t t) {
+    if (drop[t])
+      return;
+    for (std::size_t k = 3 * t; k < 3 * t + 3 && edges.neighbours[k] != no_neighbour; ++k)
+      edges.neighbours[k] = renumbered[edges.neighbours[k]];
+  });
+  // The dropped triangles' slots leave the list: the runs between them move down.
+  auto write = edges.neighbours.begin();
+  std::size_t run_begin = 0;
+  for (std::size_t i = 0; i <= dropped.size(); ++i) {
+    const std::size_t run_end = i < dropped.size() ? dropped[i] : count;
+    write = std::copy(edges.neighbours.begin() + static_cast<std::ptrdiff_t>(3 * run_begin),
+                      edges.neighbours.begin() + static_cast<std::ptrdiff_t>(3 * run_end), write);
+    run_begin = run_end + 1;
+  }
+  edges.neighbours.resize(3 * (count - dropped.size()));
+
+  // The boundary without the gone edges, with the opened ones, in key order.
+  std::sort(gone.begin(), gone.end());
+  std::sort(opened.begin(), opened.end());
+  std::vector<EdgeKey> boundary;
+  std::vector<std::uint32_t> boundary_triangle;
+  boundary.reserve(edges.boundary.size() + opened.size());
+  boundary_triangle.reserve(boundary.capacity());
+  auto next_opened = opened.begin();
+  auto next_gone = gone.begin();
+  for (std::size_t e = 0; e <= edges.boundary.size(); ++e) {
+    const bool last = e == edges.boundary.size();
+    for (; next_opened != opened.end() && (last || next_opened->first < edges.boundary[e]);
+         ++next_opened) {
+      boundary.push_back(next_opened->first);
+      boundary_triangle.push_back(renumbered[next_opened->second]);
+    }
+    if (last)
+      break;
+    if (next_gone != gone.end() && *next_gone == edges.boundary[e]) {
+      ++next_gone;
+      continue;
+    }
+    boundary.push_back(edges.boundary[e]);
+    boundary_triangle.push_back(renumbered[edges.boundary_triangle[e]]);
+  }
+  edges.boundary = std::move(boundary);
+  edges.boundary_triangle = std::move(boundary_triangle);
+  return true;
+}
+
 std::vector<std::vector<VertexIndex>> boundaryLoops(const std::vector<EdgeKey> &boundary) {
   // Boundary edges in both directions, sorted: a CSR of boundary neighbours.
   struct HalfEdge {
@@ -322,8 +422,9 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
   // Room for the fillings, so that they join the list while its neighbours
   // are held: moving a 20M-triangle list then would add 240 MB to the peak.
   triangles.reserve(triangles.size() + triangles.size() / fill_room_divisor + min_fill_room);
+  // One scan of the edges; removals and fillings update it from then on.
+  detail::MeshEdges edges = detail::meshEdges(triangles, true);
   auto fillThenOrient = [&](int max_edges, const std::vector<bool> *only_around) {
-    detail::MeshEdges edges = detail::meshEdges(triangles, true);
     surface.boundary_loops = detail::boundaryLoops(edges.boundary);
     std::vector<Triangle> filling;
     const std::size_t filled = detail::fillLoops(triangles, surface.boundary_loops, points,
@@ -359,8 +460,9 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
                                                  [&](VertexIndex v) { return anchored[v]; });
     const std::size_t before = triangles.size();
     std::vector<bool> touched(points.size(), false);
-    detail::dropTriangles(triangles, drop, touched);
-    splitBowTies(triangles, points.size(), touched, fixed_triangles ? &fixed : nullptr);
+    detail::dropTriangles(triangles, drop, touched, &edges);
+    detail::splitBowTies(triangles, points.size(), touched, fixed_triangles ? &fixed : nullptr,
+                         &edges);
     surface.twist_triangles_removed += before - triangles.size();
     // The loops that removal opened are ours to close, whatever the user's limit.
     to_cut = fillThenOrient(max_untwist_loop_edges, &touched);

@@ -72,6 +72,15 @@ MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_neighbours
 /// as meshEdges(triangles, true), without a scan of the whole list.
 void addFilling(MeshEdges &edges, const std::vector<Triangle> &triangles, std::size_t first_new);
 
+/// Updates `edges` (with neighbours) of `triangles` to describe the list
+/// without the triangles marked in `drop`, numbered as dropTriangles leaves
+/// them: the same as meshEdges(kept, true) after a scan of the whole list,
+/// at the cost of the dropped triangles and one pass over the slots. False,
+/// with `edges` unchanged, where an edge has three triangles or more (such
+/// edges have no slots to update).
+bool dropFromMeshEdges(MeshEdges &edges, const std::vector<Triangle> &triangles,
+                       const std::vector<bool> &drop);
+
 /// Cyclic boundary loops traced along boundary edges (sorted), each starting
 /// at its smallest vertex, in order of that vertex.
 std::vector<std::vector<VertexIndex>> boundaryLoops(const std::vector<EdgeKey> &boundary);
@@ -98,9 +107,15 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
                                                  std::vector<bool> &component_orientable,
                                                  const Eigen::Vector3d *viewpoint);
 
-/// Drops the marked triangles; their corners are marked in touched.
+/// Drops the marked triangles; their corners are marked in touched. With
+/// `edges` (with neighbours, of `triangles`), keeps them up to date.
 void dropTriangles(std::vector<Triangle> &triangles, const std::vector<bool> &drop,
-                   std::vector<bool> &touched);
+                   std::vector<bool> &touched, MeshEdges *edges = nullptr);
+
+/// splitBowTies() keeping `edges` (with neighbours) up to date.
+std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_count,
+                         std::vector<bool> &touched, const std::vector<Triangle> *fixed,
+                         MeshEdges *edges);
 
 } // namespace detail
 } // namespace pcl_ms

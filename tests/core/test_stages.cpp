@@ -621,6 +621,79 @@ TEST(Finish, FillingUpdateMatchesANewEdgeScan) {
   EXPECT_FALSE(scanned.boundary.empty());
 }
 
+// The twist repair and the bow-tie split drop triangles; finishing updates
+// the edge scan for them instead of scanning again. The update must give
+// exactly what a new scan gives: scattered triangles, triangles with their
+// neighbours, rim triangles, none, all, and a list with an edge of three
+// triangles (no slots to update: scanned again).
+TEST(Finish, DropUpdateMatchesANewEdgeScan) {
+  const std::vector<Triangle> patch = holedBunnyPatch(47);
+  const detail::MeshEdges patch_edges = detail::meshEdges(patch, true);
+  auto expectDropMatchesScan = [](std::vector<Triangle> triangles, detail::MeshEdges edges,
+                                  const std::vector<bool> &drop) {
+    const std::size_t kept = static_cast<std::size_t>(std::count(drop.begin(), drop.end(), false));
+    std::vector<bool> touched(200000, false);
+    detail::dropTriangles(triangles, drop, touched, &edges);
+    ASSERT_EQ(triangles.size(), kept);
+    expectSameEdges(edges, detail::meshEdges(triangles, true));
+  };
+  std::vector<bool> drop(patch.size(), false);
+  {
+    SCOPED_TRACE("scattered");
+    for (std::size_t t = 0; t < patch.size(); t += 13)
+      drop[t] = true;
+    expectDropMatchesScan(patch, patch_edges, drop);
+  }
+  {
+    SCOPED_TRACE("with their neighbours");
+    std::fill(drop.begin(), drop.end(), false);
+    for (std::size_t t = 5; t < patch.size(); t += 101) {
+      drop[t] = true;
+      for (std::size_t k = 3 * t; k < 3 * t + 3; ++k)
+        if (patch_edges.neighbours[k] != detail::no_neighbour)
+          drop[patch_edges.neighbours[k]] = true;
+    }
+    expectDropMatchesScan(patch, patch_edges, drop);
+  }
+  {
+    SCOPED_TRACE("on the rim");
+    std::fill(drop.begin(), drop.end(), false);
+    for (std::size_t e = 0; e < patch_edges.boundary_triangle.size(); e += 3)
+      drop[patch_edges.boundary_triangle[e]] = true;
+    expectDropMatchesScan(patch, patch_edges, drop);
+  }
+  {
+    SCOPED_TRACE("none, then all");
+    std::fill(drop.begin(), drop.end(), false);
+    expectDropMatchesScan(patch, patch_edges, drop);
+    std::fill(drop.begin(), drop.end(), true);
+    expectDropMatchesScan(patch, patch_edges, drop);
+  }
+  {
+    SCOPED_TRACE("an edge of three triangles");
+    const std::vector<Triangle> fin = {{0, 1, 2}, {0, 1, 3}, {0, 1, 4}, {1, 2, 5}, {2, 5, 6}};
+    const detail::MeshEdges fin_edges = detail::meshEdges(fin, true);
+    detail::MeshEdges unchanged = fin_edges;
+    EXPECT_FALSE(detail::dropFromMeshEdges(unchanged, fin, {false, false, false, true, false}));
+    expectSameEdges(unchanged, fin_edges);
+    expectDropMatchesScan(fin, fin_edges, {false, false, false, true, false});
+    expectDropMatchesScan(fin, fin_edges, {false, true, false, false, false});
+  }
+}
+
+// The bow-tie split keeps the edge scan it is given up to date through
+// each of its rounds (the example of BowTies.SplitKeepsTheLargerFan...).
+TEST(Finish, BowTieSplitKeepsTheEdgeScanUpToDate) {
+  std::vector<Triangle> triangles = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4},  {0, 5, 6},
+                                     {0, 6, 7}, {7, 8, 9}, {7, 9, 10}, {6, 7, 11}};
+  detail::MeshEdges edges = detail::meshEdges(triangles, true);
+  std::vector<bool> touched(12, false);
+  touched[0] = true;
+  EXPECT_EQ(detail::splitBowTies(triangles, 12, touched, nullptr, &edges), 3u);
+  EXPECT_EQ(triangles.size(), 5u);
+  expectSameEdges(edges, detail::meshEdges(triangles, true));
+}
+
 // Finishing keeps room for the fillings beside the triangle list (1/256 of
 // it plus 64); more fillings move the list and scan it again. Either way
 // the surface is the list with its fillings, oriented, loops traced anew:
