@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 namespace pcl_ms {
 namespace detail {
@@ -43,10 +42,6 @@ bool runsFromTo(const Triangle &t, VertexIndex a, VertexIndex b) {
 // rest without sorting (see orientAlongNeighbours); any value gives the
 // same orientation, this one leaves few edges to sort on a smooth surface.
 constexpr double kruskal_flat_bending = 0.5;
-
-// How far ahead the breadth-first walk fetches: slots, then what they point to.
-constexpr std::size_t walk_prefetch_far = 16;
-constexpr std::size_t walk_prefetch_near = 8;
 
 /// How much the surface bends across the edge that t and u share.
 double bendingAt(std::uint32_t t, std::uint32_t u, const std::vector<Triangle> &triangles,
@@ -81,6 +76,42 @@ bool consistentlyOriented(const Triangle &t, const Triangle &u) {
     if (runsFromTo(u, t[(k + 1) % 3], t[k]))
       return true;
   return false;
+}
+
+/// How many parts joinInParallel() calls its joins with: ranges of at least
+/// 4,096 triangles, at most 64 of them, and the edges between them.
+std::size_t joinParts(std::size_t triangle_count) {
+  constexpr std::size_t max_ranges = 64, min_range = std::size_t(1) << 12;
+  return std::max<std::size_t>(1, std::min(max_ranges, triangle_count / min_range)) + 1;
+}
+
+/// Calls join(t, u, part) for every manifold edge, from its lower triangle
+/// t, where `join` joins t and u in a ParityForest of the triangles. The
+/// triangles are cut into ranges; the edges within a range are joined in
+/// parallel, one task per range (part = the range: its forest entries point
+/// only within it), then the edges between ranges one by one (part =
+/// ranges). A parity forest whose roots are the first triangles ends with
+/// the same sets and flips whatever order its joins come in, so the result
+/// does not depend on the threads.
+template <typename Join>
+void joinInParallel(std::size_t count, const std::vector<std::uint32_t> &neighbours,
+                    const Join &join) {
+  const std::size_t ranges = joinParts(count) - 1;
+  auto rangeBegin = [&](std::size_t range) { return count * range / ranges; };
+  tbb::parallel_for(std::size_t(0), ranges, [&](std::size_t range) {
+    const std::size_t end = rangeBegin(range + 1);
+    for (std::size_t t = rangeBegin(range); t < end; ++t)
+      for (std::uint32_t u : neighboursOf(neighbours, static_cast<std::uint32_t>(t)))
+        if (u > t && u < end)
+          join(static_cast<std::uint32_t>(t), u, range);
+  });
+  for (std::size_t range = 0; range < ranges; ++range) {
+    const std::size_t end = rangeBegin(range + 1);
+    for (std::size_t t = rangeBegin(range); t < end; ++t)
+      for (std::uint32_t u : neighboursOf(neighbours, static_cast<std::uint32_t>(t)))
+        if (u >= end)
+          join(static_cast<std::uint32_t>(t), u, ranges);
+  }
 }
 
 /// Whether a walk of at most max_steps triangles from a triangle across
@@ -151,61 +182,56 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
                                                  std::vector<std::uint32_t> &triangle_component,
                                                  std::vector<bool> &component_orientable,
                                                  const Eigen::Vector3d *viewpoint) {
-  const std::uint32_t unvisited = std::numeric_limits<std::uint32_t>::max();
-  // Sets the orientation of u from its already oriented neighbour t.
-  auto orientAcross = [&](std::uint32_t t, std::uint32_t u, std::uint32_t component) {
-    if (!consistentlyOriented(triangles[t], triangles[u]))
-      std::swap(triangles[u][1], triangles[u][2]);
-    triangle_component[u] = component;
-    return u;
-  };
-
   // A consistent orientation, where one exists, is the same whatever order
-  // it spreads in: breadth first, each component from its first triangle.
-  triangle_component.assign(triangles.size(), unvisited);
+  // it spreads in: each component's first triangle keeps its orientation
+  // and the others follow across the manifold edges, joined in a parity
+  // forest (whose roots are the first triangles) in any order. A component
+  // where some join conflicts has none.
+  const std::size_t count = triangles.size();
+  ParityForest forest(count);
+  std::vector<std::uint8_t> conflicted(count, 0);
+  // Flipping exactly one of the two changes whether they agree.
+  auto join = [&](std::uint32_t t, std::uint32_t u) {
+    return forest.join(t, u, !consistentlyOriented(triangles[t], triangles[u]));
+  };
+  joinInParallel(count, neighbours, [&](std::uint32_t t, std::uint32_t u, std::size_t) {
+    if (join(t, u) == ParityForest::Join::conflict)
+      conflicted[t] = 1;
+  });
+  // Components numbered by their first triangles, in order; triangles of
+  // orientable ones turned to agree with it.
+  triangle_component.assign(count, 0);
   component_orientable.clear();
-  std::vector<std::vector<std::uint32_t>> members;
-  for (std::uint32_t seed = 0; seed < triangles.size(); ++seed) {
-    if (triangle_component[seed] != unvisited)
-      continue;
-    const std::uint32_t component = static_cast<std::uint32_t>(component_orientable.size());
-    component_orientable.push_back(true);
-    members.push_back({seed});
-    triangle_component[seed] = component;
-    std::vector<std::uint32_t> &queue = members.back();
-    for (std::size_t head = 0; head < queue.size(); ++head) {
-      // The walk jumps through memory: fetch the slots of the triangle 16
-      // places ahead, and what the one 8 places ahead will read next.
-      if (head + walk_prefetch_far < queue.size())
-        __builtin_prefetch(&neighbours[3 * std::size_t{queue[head + walk_prefetch_far]}]);
-      if (head + walk_prefetch_near < queue.size())
-        for (std::uint32_t u : neighboursOf(neighbours, queue[head + walk_prefetch_near])) {
-          __builtin_prefetch(&triangle_component[u]);
-          __builtin_prefetch(&triangles[u]);
-        }
-      const std::uint32_t t = queue[head];
-      for (std::uint32_t u : neighboursOf(neighbours, t))
-        if (triangle_component[u] == unvisited)
-          queue.push_back(orientAcross(t, u, component));
+  std::vector<std::uint32_t> component_size;
+  std::vector<std::uint8_t> flipped(count, 0);
+  for (std::uint32_t t = 0; t < count; ++t) {
+    const auto [root, flip] = forest.find(t);
+    if (root == t) {
+      triangle_component[t] = static_cast<std::uint32_t>(component_orientable.size());
+      component_orientable.push_back(true);
+      component_size.push_back(0);
+    } else {
+      triangle_component[t] = triangle_component[root];
     }
+    flipped[t] = flip;
+    ++component_size[triangle_component[t]];
   }
+  forest = ParityForest(0);
+  for (std::uint32_t t = 0; t < count; ++t)
+    if (conflicted[t])
+      component_orientable[triangle_component[t]] = false;
+  std::vector<std::uint8_t>().swap(conflicted);
+  forEachIndex(count, [&](std::size_t t) {
+    if (flipped[t] && component_orientable[triangle_component[t]])
+      std::swap(triangles[t][1], triangles[t][2]);
+  });
+  std::vector<std::uint8_t>().swap(flipped);
   // Each manifold edge once: from its lower-numbered triangle.
   auto forEachEdgeOf = [&](std::uint32_t t, const auto &visit) {
     for (std::uint32_t u : neighboursOf(neighbours, t))
       if (u > t)
         visit(u);
   };
-  {
-    std::vector<std::uint8_t> disagrees(triangles.size(), 0);
-    forEachIndex(triangles.size(), [&](std::size_t t) {
-      forEachEdgeOf(static_cast<std::uint32_t>(t), [&](std::uint32_t u) {
-        disagrees[t] |= !consistentlyOriented(triangles[t], triangles[u]);
-      });
-    });
-    for (std::size_t t = 0; t < triangles.size(); ++t)
-      if (disagrees[t])
-        component_orientable[triangle_component[t]] = false;
-  }
 
   // Where none exists, orientation follows a maximum spanning forest on
   // flatness (edges joined flattest first, Kruskal's order), so that the
@@ -225,61 +251,42 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
     // computed a block of triangles at a time, never stored for every edge
     // (at 10M points that was 240 MB). A twist among flat edges needs
     // Kruskal's order throughout. Ties are broken by the edge's key.
-    ParityForest forest(triangles.size());
-    // Flipping exactly one of the two changes whether they agree.
-    auto join = [&](std::uint32_t t, std::uint32_t u) {
-      return forest.join(t, u, !consistentlyOriented(triangles[t], triangles[u]));
-    };
+    forest = ParityForest(count);
     struct BentEdge {
       double bending;
       EdgeKey key;
       std::uint32_t t, u;
     };
     std::vector<BentEdge> bent_edges;
-    // Calls take(t, u, bending) for each manifold edge of a twisted component.
-    auto forEachTwistedEdge = [&](const auto &take) {
-      constexpr std::size_t block = std::size_t(1) << 18;
-      std::vector<double> bending;
-      for (std::size_t first = 0; first < triangles.size(); first += block) {
-        const std::size_t count = std::min(block, triangles.size() - first);
-        bending.assign(3 * count, 0.0);
-        forEachIndex(count, [&](std::size_t i) {
-          const std::uint32_t t = static_cast<std::uint32_t>(first + i);
-          if (!inTwistedComponent(t))
-            return;
-          std::size_t slot = 3 * i;
-          forEachEdgeOf(
-              t, [&](std::uint32_t u) { bending[slot++] = bendingAt(t, u, triangles, points); });
-        });
-        for (std::size_t i = 0; i < count; ++i) {
-          const std::uint32_t t = static_cast<std::uint32_t>(first + i);
-          // The joins read the neighbours' forest entries and corners.
-          if (i + walk_prefetch_near < count)
-            forEachEdgeOf(t + walk_prefetch_near, [&](std::uint32_t u) {
-              forest.prefetch(u);
-              __builtin_prefetch(&triangles[u]);
-            });
-          if (!inTwistedComponent(t))
-            continue;
-          std::size_t slot = 3 * i;
-          forEachEdgeOf(t, [&](std::uint32_t u) { take(t, u, bending[slot++]); });
-        }
-      }
+    auto bentEdge = [&](std::uint32_t t, std::uint32_t u, double bending) {
+      return BentEdge{bending, sharedEdge(triangles[t], triangles[u]), t, u};
     };
-    auto keepBent = [&](std::uint32_t t, std::uint32_t u, double bending) {
-      bent_edges.push_back({bending, sharedEdge(triangles[t], triangles[u]), t, u});
-    };
-    bool flat_cycle_twisted = false;
-    forEachTwistedEdge([&](std::uint32_t t, std::uint32_t u, double bending) {
-      if (bending < kruskal_flat_bending)
-        flat_cycle_twisted |= join(t, u) == ParityForest::Join::conflict;
-      else
-        keepBent(t, u, bending);
+    // The flat edges joined in parallel, the bent ones kept per part.
+    std::vector<std::vector<BentEdge>> bent_in_part(joinParts(count));
+    std::vector<std::uint8_t> flat_twist_in_part(bent_in_part.size(), 0);
+    joinInParallel(count, neighbours, [&](std::uint32_t t, std::uint32_t u, std::size_t part) {
+      if (!inTwistedComponent(t))
+        return;
+      const double bending = bendingAt(t, u, triangles, points);
+      if (bending >= kruskal_flat_bending)
+        bent_in_part[part].push_back(bentEdge(t, u, bending));
+      else if (join(t, u) == ParityForest::Join::conflict)
+        flat_twist_in_part[part] = 1;
     });
-    if (flat_cycle_twisted) {
-      forest = ParityForest(triangles.size());
-      bent_edges.clear();
-      forEachTwistedEdge(keepBent);
+    if (std::find(flat_twist_in_part.begin(), flat_twist_in_part.end(), 1) !=
+        flat_twist_in_part.end()) {
+      // A twist among flat edges: Kruskal's order throughout.
+      forest = ParityForest(count);
+      for (std::vector<BentEdge> &part : bent_in_part)
+        part.clear();
+      joinInParallel(count, neighbours, [&](std::uint32_t t, std::uint32_t u, std::size_t part) {
+        if (inTwistedComponent(t))
+          bent_in_part[part].push_back(bentEdge(t, u, bendingAt(t, u, triangles, points)));
+      });
+    }
+    for (std::vector<BentEdge> &part : bent_in_part) {
+      bent_edges.insert(bent_edges.end(), part.begin(), part.end());
+      std::vector<BentEdge>().swap(part);
     }
     std::sort(bent_edges.begin(), bent_edges.end(), [](const BentEdge &a, const BentEdge &b) {
       return a.bending < b.bending || (a.bending == b.bending && a.key < b.key);
@@ -352,12 +359,12 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
       return facing(t) < facing(u) ? t : u;
     };
     TwistWalk walk(triangles.size());
-    std::vector<bool> holds_real_twist(members.size(), false);
+    std::vector<bool> holds_real_twist(component_size.size(), false);
     for (const Conflict &conflict : conflicts) {
       const std::uint32_t t = conflict.t, u = conflict.u;
       const std::uint32_t component = triangle_component[t];
       const int long_walk = static_cast<int>(
-          max_twist_steps_per_root * std::sqrt(static_cast<double>(members[component].size())));
+          max_twist_steps_per_root * std::sqrt(static_cast<double>(component_size[component])));
       auto localTwist = [&]() {
         if (walk.reversesWithin(t, max_local_twist_steps, triangles, neighbours))
           return true;
@@ -376,35 +383,34 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
       }
     }
   }
-  for (std::uint32_t component = 0; component < members.size(); ++component) {
+  // Outward for closed surfaces; towards the viewpoint for open ones when
+  // there is one (area-weighted); a fixed, reproducible choice otherwise.
+  // Summed in triangle order, so that the sums do not depend on a walk.
+  std::vector<double> signed_volume(component_size.size(), 0.0), facing;
+  std::vector<bool> closed(component_size.size(), true);
+  if (viewpoint)
+    facing.assign(component_size.size(), 0.0);
+  for (std::uint32_t t = 0; t < count; ++t) {
+    const std::uint32_t component = triangle_component[t];
     if (!component_orientable[component])
       continue;
-    // Outward for closed surfaces; towards the viewpoint for open ones when
-    // there is one (area-weighted); a fixed, reproducible choice otherwise.
-    double signed_volume = 0, facing = 0;
-    bool closed = true;
-    const std::vector<std::uint32_t> &walked = members[component];
-    for (std::size_t i = 0; i < walked.size(); ++i) {
-      // Walk order jumps through memory, as above.
-      if (i + walk_prefetch_far < walked.size()) {
-        __builtin_prefetch(&triangles[walked[i + walk_prefetch_far]]);
-        __builtin_prefetch(&neighbours[3 * std::size_t{walked[i + walk_prefetch_far]}]);
-      }
-      if (i + walk_prefetch_near < walked.size())
-        for (VertexIndex v : triangles[walked[i + walk_prefetch_near]])
-          __builtin_prefetch(&points[v]);
-      const std::uint32_t t = walked[i];
-      const Eigen::Vector3d &a = points[triangles[t][0]], &b = points[triangles[t][1]],
-                            &c = points[triangles[t][2]];
-      signed_volume += a.dot(b.cross(c));
-      if (viewpoint)
-        facing += (b - a).cross(c - a).dot(*viewpoint - a);
-      closed = closed && neighboursOf(neighbours, t).size() == 3;
-    }
-    if ((viewpoint && !closed ? facing : signed_volume) < 0)
-      for (std::uint32_t t : members[component])
-        std::swap(triangles[t][1], triangles[t][2]);
+    const Eigen::Vector3d &a = points[triangles[t][0]], &b = points[triangles[t][1]],
+                          &c = points[triangles[t][2]];
+    signed_volume[component] += a.dot(b.cross(c));
+    if (viewpoint)
+      facing[component] += (b - a).cross(c - a).dot(*viewpoint - a);
+    if (neighboursOf(neighbours, t).size() != 3)
+      closed[component] = false;
   }
+  std::vector<std::uint8_t> turn(component_size.size(), 0);
+  for (std::size_t component = 0; component < turn.size(); ++component)
+    turn[component] =
+        component_orientable[component] &&
+        (viewpoint && !closed[component] ? facing[component] : signed_volume[component]) < 0;
+  forEachIndex(count, [&](std::size_t t) {
+    if (turn[triangle_component[t]])
+      std::swap(triangles[t][1], triangles[t][2]);
+  });
   return to_cut;
 }
 
