@@ -78,41 +78,86 @@ bool consistentlyOriented(const Triangle &t, const Triangle &u) {
   return false;
 }
 
-/// How many parts joinInParallel() calls its joins with: ranges of at least
-/// 4,096 triangles, at most 64 of them, and the edges between them.
-std::size_t joinParts(std::size_t triangle_count) {
-  constexpr std::size_t max_ranges = 64, min_range = std::size_t(1) << 12;
-  return std::max<std::size_t>(1, std::min(max_ranges, triangle_count / min_range)) + 1;
-}
-
-/// Calls join(t, u, part) for every manifold edge, from its lower triangle
-/// t, where `join` joins t and u in a ParityForest of the triangles. The
-/// triangles are cut into ranges; the edges within a range are joined in
-/// parallel, one task per range (part = the range: its forest entries point
-/// only within it), then the edges between ranges one by one (part =
-/// ranges). A parity forest whose roots are the first triangles ends with
-/// the same sets and flips whatever order its joins come in, so the result
-/// does not depend on the threads.
-template <typename Join>
-void joinInParallel(std::size_t count, const std::vector<std::uint32_t> &neighbours,
-                    const Join &join) {
-  const std::size_t ranges = joinParts(count) - 1;
-  auto rangeBegin = [&](std::size_t range) { return count * range / ranges; };
-  tbb::parallel_for(std::size_t(0), ranges, [&](std::size_t range) {
-    const std::size_t end = rangeBegin(range + 1);
-    for (std::size_t t = rangeBegin(range); t < end; ++t)
-      for (std::uint32_t u : neighboursOf(neighbours, static_cast<std::uint32_t>(t)))
-        if (u > t && u < end)
-          join(static_cast<std::uint32_t>(t), u, range);
-  });
-  for (std::size_t range = 0; range < ranges; ++range) {
-    const std::size_t end = rangeBegin(range + 1);
-    for (std::size_t t = rangeBegin(range); t < end; ++t)
-      for (std::uint32_t u : neighboursOf(neighbours, static_cast<std::uint32_t>(t)))
-        if (u >= end)
-          join(static_cast<std::uint32_t>(t), u, ranges);
+/// The manifold edges, each once (from its lower triangle t to u), for
+/// joining in a ParityForest of the triangles in parallel. The triangles
+/// are cut into ranges by their lowest corner (the points are in spatial
+/// order, so most neighbours share a range; by triangle number 40 % of the
+/// edges of a 1M-point surface crossed ranges); the edges within a range are
+/// joined in parallel, one task per range, whose forest entries point only
+/// within it; then the edges between ranges, one by one. A parity forest
+/// whose roots are the first triangles ends with the same sets and flips
+/// whatever order its joins come in, so the result does not depend on the
+/// threads.
+class ParallelJoins {
+public:
+  ParallelJoins(const std::vector<Triangle> &triangles, std::size_t vertex_count,
+                const std::vector<std::uint32_t> &neighbours)
+      : triangles_(triangles), neighbours_(neighbours),
+        ranges_(std::max<std::size_t>(1, std::min(max_ranges, triangles.size() / min_range))),
+        vertex_count_(std::max<std::size_t>(1, vertex_count)), first_(ranges_ + 1, 0),
+        order_(triangles.size()), between_(ranges_) {
+    for (std::uint32_t t = 0; t < triangles.size(); ++t)
+      ++first_[rangeOf(t) + 1];
+    for (std::size_t range = 0; range < ranges_; ++range)
+      first_[range + 1] += first_[range];
+    std::vector<std::uint32_t> next(first_.begin(), first_.end() - 1);
+    for (std::uint32_t t = 0; t < triangles.size(); ++t)
+      order_[next[rangeOf(t)]++] = t;
+    // The few edges between ranges (1 % of a 1M-point surface's), listed
+    // once: finding them by a scan of every triangle cost each call as
+    // much as joining all the others in parallel.
+    tbb::parallel_for(std::size_t(0), ranges_, [&](std::size_t range) {
+      forEachEdgeOf(range, [&](std::uint32_t t, std::uint32_t u, bool within) {
+        if (!within)
+          between_[range].emplace_back(t, u);
+      });
+    });
   }
-}
+
+  /// How many parts forEachEdge() passes: the ranges, then the edges between.
+  std::size_t parts() const { return ranges_ + 1; }
+
+  /// Calls join(t, u, part) for every edge.
+  template <typename Join> void forEachEdge(const Join &join) const {
+    tbb::parallel_for(std::size_t(0), ranges_, [&](std::size_t range) {
+      forEachEdgeOf(range, [&](std::uint32_t t, std::uint32_t u, bool within) {
+        if (within)
+          join(t, u, range);
+      });
+    });
+    for (const auto &edges : between_)
+      for (const auto &[t, u] : edges)
+        join(t, u, ranges_);
+  }
+
+private:
+  static constexpr std::size_t max_ranges = 64, min_range = std::size_t(1) << 12;
+
+  /// Calls visit(t, u, within) for the edges whose lower triangle t is in
+  /// the range, saying whether u is in it too.
+  template <typename Visit> void forEachEdgeOf(std::size_t range, const Visit &visit) const {
+    for (std::size_t i = first_[range]; i < first_[range + 1]; ++i) {
+      const std::uint32_t t = order_[i];
+      for (std::uint32_t u : neighboursOf(neighbours_, t))
+        if (u > t)
+          visit(t, u, rangeOf(u) == range);
+    }
+  }
+
+  std::size_t rangeOf(std::uint32_t t) const {
+    const Triangle &corners = triangles_[t];
+    const std::uint64_t lowest = std::min({corners[0], corners[1], corners[2]});
+    return static_cast<std::size_t>(
+        std::min<std::uint64_t>(lowest * ranges_ / vertex_count_, ranges_ - 1));
+  }
+
+  const std::vector<Triangle> &triangles_;
+  const std::vector<std::uint32_t> &neighbours_;
+  std::size_t ranges_, vertex_count_;
+  std::vector<std::uint32_t> first_; // the ranges' starts in order_
+  std::vector<std::uint32_t> order_; // the triangles, range by range
+  std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> between_; // per range
+};
 
 /// Whether a walk of at most max_steps triangles from a triangle across
 /// manifold edges returns to it with its orientation reversed (crossing an
@@ -194,7 +239,8 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
   auto join = [&](std::uint32_t t, std::uint32_t u) {
     return forest.join(t, u, !consistentlyOriented(triangles[t], triangles[u]));
   };
-  joinInParallel(count, neighbours, [&](std::uint32_t t, std::uint32_t u, std::size_t) {
+  const ParallelJoins edges(triangles, points.size(), neighbours);
+  edges.forEachEdge([&](std::uint32_t t, std::uint32_t u, std::size_t) {
     if (join(t, u) == ParityForest::Join::conflict)
       conflicted[t] = 1;
   });
@@ -262,9 +308,9 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
       return BentEdge{bending, sharedEdge(triangles[t], triangles[u]), t, u};
     };
     // The flat edges joined in parallel, the bent ones kept per part.
-    std::vector<std::vector<BentEdge>> bent_in_part(joinParts(count));
+    std::vector<std::vector<BentEdge>> bent_in_part(edges.parts());
     std::vector<std::uint8_t> flat_twist_in_part(bent_in_part.size(), 0);
-    joinInParallel(count, neighbours, [&](std::uint32_t t, std::uint32_t u, std::size_t part) {
+    edges.forEachEdge([&](std::uint32_t t, std::uint32_t u, std::size_t part) {
       if (!inTwistedComponent(t))
         return;
       const double bending = bendingAt(t, u, triangles, points);
@@ -279,7 +325,7 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
       forest = ParityForest(count);
       for (std::vector<BentEdge> &part : bent_in_part)
         part.clear();
-      joinInParallel(count, neighbours, [&](std::uint32_t t, std::uint32_t u, std::size_t part) {
+      edges.forEachEdge([&](std::uint32_t t, std::uint32_t u, std::size_t part) {
         if (inTwistedComponent(t))
           bent_in_part[part].push_back(bentEdge(t, u, bendingAt(t, u, triangles, points)));
       });
