@@ -39,6 +39,33 @@ std::size_t slotOf(const Triangle &t, EdgeKey key) {
   return below;
 }
 
+/// Replaces the boundary edges of `edges` by those that `leaves(e)` keeps,
+/// with `opened` (key, triangle; sorted) merged in, in key order; every
+/// triangle number passes through `number`.
+template <typename Leaves, typename Number>
+void mergeBoundary(MeshEdges &edges, const std::vector<std::pair<EdgeKey, std::uint32_t>> &opened,
+                   const Leaves &leaves, const Number &number) {
+  std::vector<EdgeKey> boundary;
+  std::vector<std::uint32_t> boundary_triangle;
+  boundary.reserve(edges.boundary.size() + opened.size());
+  boundary_triangle.reserve(boundary.capacity());
+  auto next_opened = opened.begin();
+  for (std::size_t e = 0; e <= edges.boundary.size(); ++e) {
+    const bool last = e == edges.boundary.size();
+    for (; next_opened != opened.end() && (last || next_opened->first < edges.boundary[e]);
+         ++next_opened) {
+      boundary.push_back(next_opened->first);
+      boundary_triangle.push_back(number(next_opened->second));
+    }
+    if (!last && !leaves(e)) {
+      boundary.push_back(edges.boundary[e]);
+      boundary_triangle.push_back(number(edges.boundary_triangle[e]));
+    }
+  }
+  edges.boundary = std::move(boundary);
+  edges.boundary_triangle = std::move(boundary_triangle);
+}
+
 } // namespace
 
 MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_neighbours,
@@ -215,23 +242,8 @@ void addFilling(MeshEdges &edges, const std::vector<Triangle> &triangles, std::s
   }
   // The boundary without the closed edges, with the opened ones, in key order.
   std::sort(opened.begin(), opened.end());
-  std::vector<EdgeKey> boundary;
-  std::vector<std::uint32_t> boundary_triangle;
-  auto next_opened = opened.begin();
-  for (std::size_t e = 0; e <= edges.boundary.size(); ++e) {
-    const bool last = e == edges.boundary.size();
-    for (; next_opened != opened.end() && (last || next_opened->first < edges.boundary[e]);
-         ++next_opened) {
-      boundary.push_back(next_opened->first);
-      boundary_triangle.push_back(next_opened->second);
-    }
-    if (!last && !closed[e]) {
-      boundary.push_back(edges.boundary[e]);
-      boundary_triangle.push_back(edges.boundary_triangle[e]);
-    }
-  }
-  edges.boundary = std::move(boundary);
-  edges.boundary_triangle = std::move(boundary_triangle);
+  mergeBoundary(
+      edges, opened, [&](std::size_t e) { return closed[e]; }, [](std::uint32_t t) { return t; });
 }
 
 bool dropFromMeshEdges(MeshEdges &edges, const std::vector<Triangle> &triangles,
@@ -307,30 +319,12 @@ bool dropFromMeshEdges(MeshEdges &edges, const std::vector<Triangle> &triangles,
   // The boundary without the gone edges, with the opened ones, in key order.
   std::sort(gone.begin(), gone.end());
   std::sort(opened.begin(), opened.end());
-  std::vector<EdgeKey> boundary;
-  std::vector<std::uint32_t> boundary_triangle;
-  boundary.reserve(edges.boundary.size() + opened.size());
-  boundary_triangle.reserve(boundary.capacity());
-  auto next_opened = opened.begin();
-  auto next_gone = gone.begin();
-  for (std::size_t e = 0; e <= edges.boundary.size(); ++e) {
-    const bool last = e == edges.boundary.size();
-    for (; next_opened != opened.end() && (last || next_opened->first < edges.boundary[e]);
-         ++next_opened) {
-      boundary.push_back(next_opened->first);
-      boundary_triangle.push_back(renumbered[next_opened->second]);
-    }
-    if (last)
-      break;
-    if (next_gone != gone.end() && *next_gone == edges.boundary[e]) {
-      ++next_gone;
-      continue;
-    }
-    boundary.push_back(edges.boundary[e]);
-    boundary_triangle.push_back(renumbered[edges.boundary_triangle[e]]);
-  }
-  edges.boundary = std::move(boundary);
-  edges.boundary_triangle = std::move(boundary_triangle);
+  mergeBoundary(
+      edges, opened,
+      [&](std::size_t e) {
+        return std::binary_search(gone.begin(), gone.end(), edges.boundary[e]);
+      },
+      [&](std::uint32_t t) { return renumbered[t]; });
   return true;
 }
 
