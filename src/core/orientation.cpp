@@ -43,9 +43,11 @@ bool runsFromTo(const Triangle &t, VertexIndex a, VertexIndex b) {
 // same orientation, this one leaves few edges to sort on a smooth surface.
 constexpr double kruskal_flat_bending = 0.5;
 
-/// How much the surface bends across the edge that t and u share.
-double bendingAt(std::uint32_t t, std::uint32_t u, const std::vector<Triangle> &triangles,
-                 const std::vector<Eigen::Vector3d> &points) {
+/// Calls measure(p, q, t's apex, u's apex) for the edge pq (p the lower
+/// vertex) that t and u share.
+template <typename Measure>
+auto acrossSharedEdge(std::uint32_t t, std::uint32_t u, const std::vector<Triangle> &triangles,
+                      const std::vector<Eigen::Vector3d> &points, const Measure &measure) {
   const EdgeKey edge = sharedEdge(triangles[t], triangles[u]);
   const VertexIndex a = lowVertex(edge), b = highVertex(edge);
   auto apex = [&](std::uint32_t triangle) {
@@ -54,7 +56,24 @@ double bendingAt(std::uint32_t t, std::uint32_t u, const std::vector<Triangle> &
         return v;
     return a;
   };
-  return bendingAngle(points[a], points[b], points[apex(t)], points[apex(u)]);
+  return measure(points[a], points[b], points[apex(t)], points[apex(u)]);
+}
+
+/// How much the surface bends across the edge that t and u share.
+double bendingAt(std::uint32_t t, std::uint32_t u, const std::vector<Triangle> &triangles,
+                 const std::vector<Eigen::Vector3d> &points) {
+  return acrossSharedEdge(t, u, triangles, points,
+                          [](const auto &...corners) { return bendingAngle(corners...); });
+}
+
+/// Whether the surface surely bends less than kruskal_flat_bending there:
+/// most edges are flat, and this spares them the arctangent.
+bool surelyFlatAt(std::uint32_t t, std::uint32_t u, const std::vector<Triangle> &triangles,
+                  const std::vector<Eigen::Vector3d> &points) {
+  static const double flat_tan = std::tan(kruskal_flat_bending);
+  return acrossSharedEdge(t, u, triangles, points, [](const auto &...corners) {
+    return bendsSurelyLessThan(corners..., flat_tan * flat_tan);
+  });
 }
 
 /// Triangle t's manifold neighbours (MeshEdges::neighbours), in the order
@@ -313,7 +332,8 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
     edges.forEachEdge([&](std::uint32_t t, std::uint32_t u, std::size_t part) {
       if (!inTwistedComponent(t))
         return;
-      const double bending = bendingAt(t, u, triangles, points);
+      const double bending =
+          surelyFlatAt(t, u, triangles, points) ? 0.0 : bendingAt(t, u, triangles, points);
       if (bending >= kruskal_flat_bending)
         bent_in_part[part].push_back(bentEdge(t, u, bending));
       else if (join(t, u) == ParityForest::Join::conflict)

@@ -100,6 +100,45 @@ TEST(Costs, BendingAngleAcrossSharedEdge) {
   EXPECT_NEAR(bendingAngle(p, q, t, {0.5, 0, 3}), M_PI / 2, 1e-12); // right angle
 }
 
+// The twist repair tells flat edges without the arctangent where it can:
+// wherever it says "surely below", bendingAngle() must be below, right up
+// to the limit; and it must say so for most edges well inside it. Random
+// edges and apexes, including bendings within 1e-9 of the limit and
+// coinciding edge ends.
+TEST(Costs, SurelyLessBendingAgreesWithTheAngle) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const double limit = 0.5, limit_tan_squared = std::tan(limit) * std::tan(limit);
+  std::size_t sure = 0, well_inside = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const Eigen::Vector3d p(unit(random), unit(random), unit(random));
+    const Eigen::Vector3d q =
+        i % 1000 == 0
+            ? p
+            : Eigen::Vector3d(p + Eigen::Vector3d(unit(random), unit(random), unit(random)));
+    const Eigen::Vector3d axis = (q - p).normalized();
+    Eigen::Vector3d across = axis.unitOrthogonal();
+    const Eigen::Vector3d up = axis.cross(across);
+    const double along_t = unit(random), along_s = unit(random);
+    const double wanted = i % 3 == 0 ? limit + 1e-9 * unit(random) : 1.5 * (unit(random) + 1);
+    const Eigen::Vector3d t = p + along_t * (q - p) + across;
+    const Eigen::Vector3d s =
+        p + along_s * (q - p) - std::cos(wanted) * across + std::sin(wanted) * up;
+    const bool surely = bendsSurelyLessThan(p, q, t, s, limit_tan_squared);
+    const double bending = bendingAngle(p, q, t, s);
+    if (surely) {
+      ++sure;
+      ASSERT_LT(bending, limit) << i;
+    }
+    if (q != p && bending < 0.99 * limit) {
+      ++well_inside;
+      EXPECT_TRUE(surely) << i << " bending " << bending;
+    }
+  }
+  EXPECT_GT(sure, 10000u);
+  EXPECT_GT(well_inside, 10000u);
+}
+
 TEST(Costs, BendingPenaltyMatchesPaper) {
   EXPECT_DOUBLE_EQ(bendingPenalty(0.0), -1.0);
   // The paper: f is about 0 at 40 degrees (exactly at ln 2, 39.7 degrees)

@@ -45,21 +45,50 @@ inline double bendingPenalty(double bending_angle) {
   return grown * grown - 1.0;
 }
 
+namespace detail {
+
+/// The components of t - p and s - p perpendicular to the edge pq; false
+/// when p and q coincide.
+inline bool acrossEdge(const Eigen::Vector3d &p, const Eigen::Vector3d &q, const Eigen::Vector3d &t,
+                       const Eigen::Vector3d &s, Eigen::Vector3d &to_t, Eigen::Vector3d &to_s) {
+  const Eigen::Vector3d axis = q - p;
+  const double axis_squared = axis.squaredNorm();
+  if (axis_squared == 0)
+    return false;
+  to_t = (t - p) - axis * ((t - p).dot(axis) / axis_squared);
+  to_s = (s - p) - axis * ((s - p).dot(axis) / axis_squared);
+  return true;
+}
+
+} // namespace detail
+
 /// Bending angle in [0, pi] between triangles (p, q, t) and (p, q, s) across
 /// their shared edge pq: 0 when s continues the plane of t on the far side,
 /// pi when the two triangles fold onto each other.
 inline double bendingAngle(const Eigen::Vector3d &p, const Eigen::Vector3d &q,
                            const Eigen::Vector3d &t, const Eigen::Vector3d &s) {
-  const Eigen::Vector3d axis = q - p;
-  const double axis_squared = axis.squaredNorm();
-  if (axis_squared == 0)
+  Eigen::Vector3d to_t, to_s;
+  if (!detail::acrossEdge(p, q, t, s, to_t, to_s))
     return M_PI;
-  // Components of t and s perpendicular to the shared edge.
-  const Eigen::Vector3d to_t = (t - p) - axis * ((t - p).dot(axis) / axis_squared);
-  const Eigen::Vector3d to_s = (s - p) - axis * ((s - p).dot(axis) / axis_squared);
   // atan2 of |cross| and dot is accurate near 0 and pi, unlike acos.
   const double opening = std::atan2(to_t.cross(to_s).norm(), to_t.dot(to_s));
   return M_PI - opening;
+}
+
+/// Whether bendingAngle(p, q, t, s) is surely below an angle under pi / 2
+/// whose tangent squared is `limit_tan_squared`, without the arctangent:
+/// where the opening is obtuse (dot < 0) the bending is atan(|cross| /
+/// -dot), below the limit where cross^2 < limit_tan_squared dot^2. A margin
+/// of 1e-6 of the limit stands far above the rounding of both ways; false
+/// where this cannot tell, and bendingAngle() must.
+inline bool bendsSurelyLessThan(const Eigen::Vector3d &p, const Eigen::Vector3d &q,
+                                const Eigen::Vector3d &t, const Eigen::Vector3d &s,
+                                double limit_tan_squared) {
+  Eigen::Vector3d to_t, to_s;
+  if (!detail::acrossEdge(p, q, t, s, to_t, to_s))
+    return false;
+  const double dot = to_t.dot(to_s);
+  return dot < 0 && to_t.cross(to_s).squaredNorm() < (1 - 1e-6) * limit_tan_squared * dot * dot;
 }
 
 /// Eq. 2: context cost that accepted neighbour T adds to candidate S across
