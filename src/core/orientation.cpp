@@ -112,9 +112,10 @@ public:
   ParallelJoins(const std::vector<Triangle> &triangles, std::size_t vertex_count,
                 const std::vector<std::uint32_t> &neighbours)
       : triangles_(triangles), neighbours_(neighbours),
-        ranges_(std::max<std::size_t>(1, std::min(max_ranges, triangles.size() / min_range))),
-        vertex_count_(std::max<std::size_t>(1, vertex_count)), first_(ranges_ + 1, 0),
-        order_(triangles.size()), between_(ranges_) {
+        shift_(rangeShift(triangles.size(), vertex_count)),
+        ranges_(static_cast<std::size_t>((std::max<std::size_t>(vertex_count, 1) - 1) >> shift_) +
+                1),
+        first_(ranges_ + 1, 0), order_(triangles.size()), between_(ranges_) {
     for (std::uint32_t t = 0; t < triangles.size(); ++t)
       ++first_[rangeOf(t) + 1];
     for (std::size_t range = 0; range < ranges_; ++range)
@@ -163,16 +164,28 @@ private:
     }
   }
 
+  /// Ranges of 2^shift vertices (a shift, not a division: it is taken for
+  /// every edge): as few as make at most 64 ranges and, unless the
+  /// triangles are few, about 4,096 triangles or more per range.
+  static unsigned rangeShift(std::size_t triangle_count, std::size_t vertex_count) {
+    const std::size_t wanted =
+        std::max<std::size_t>(1, std::min(max_ranges, triangle_count / min_range));
+    unsigned shift = 0;
+    while ((std::max<std::size_t>(vertex_count, 1) - 1) >> shift >= wanted)
+      ++shift;
+    return shift;
+  }
+
   std::size_t rangeOf(std::uint32_t t) const {
     const Triangle &corners = triangles_[t];
-    const std::uint64_t lowest = std::min({corners[0], corners[1], corners[2]});
-    return static_cast<std::size_t>(
-        std::min<std::uint64_t>(lowest * ranges_ / vertex_count_, ranges_ - 1));
+    return std::min<std::size_t>(std::min({corners[0], corners[1], corners[2]}) >> shift_,
+                                 ranges_ - 1);
   }
 
   const std::vector<Triangle> &triangles_;
   const std::vector<std::uint32_t> &neighbours_;
-  std::size_t ranges_, vertex_count_;
+  unsigned shift_;
+  std::size_t ranges_;
   std::vector<std::uint32_t> first_; // the ranges' starts in order_
   std::vector<std::uint32_t> order_; // the triangles, range by range
   std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> between_; // per range
