@@ -15,19 +15,22 @@ namespace pcl_ms {
 namespace detail {
 namespace {
 
-/// The triangles at each marked vertex: one scan of the mesh, and memory
-/// for the marked vertices only (a few, or a seam's, of a large mesh).
+/// The triangles at each marked vertex, those marked `gone` left out: one
+/// scan of the mesh, and memory for the marked vertices only (a few, or a
+/// seam's, of a large mesh).
 class MarkedIncidence {
 public:
-  MarkedIncidence(const std::vector<Triangle> &triangles, const std::vector<bool> &marked) {
+  MarkedIncidence(const std::vector<Triangle> &triangles, const std::vector<bool> &marked,
+                  const std::vector<bool> &gone) {
     for (VertexIndex v = 0; v < marked.size(); ++v)
       if (marked[v])
         vertices_.push_back(v);
     at_.resize(vertices_.size());
     for (std::uint32_t t = 0; t < triangles.size(); ++t)
-      for (VertexIndex v : triangles[t])
-        if (v < marked.size() && marked[v])
-          at_[slot(v)].push_back(t);
+      if (!gone[t])
+        for (VertexIndex v : triangles[t])
+          if (v < marked.size() && marked[v])
+            at_[slot(v)].push_back(t);
   }
   const std::vector<VertexIndex> &vertices() const { return vertices_; }
   const std::vector<std::uint32_t> &atSlot(std::size_t slot) const { return at_[slot]; }
@@ -103,12 +106,17 @@ std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_co
   };
   touched.resize(vertex_count, false);
   // After the first round only the corners of what it removed can have
-  // gained a second fan: the other vertices kept their triangles.
+  // gained a second fan: the other vertices kept their triangles. The
+  // removed triangles leave the list once, after the last round (each
+  // removal renumbers the list and the edge scan), and are skipped until
+  // then: their order, and so every choice, is the same.
   std::vector<bool> check = touched;
+  std::vector<bool> removed(triangles.size(), false);
+  bool any_removed = false;
   for (bool changed = true; changed;) {
     changed = false;
-    const MarkedIncidence incidence(triangles, check);
-    std::vector<bool> drop(triangles.size(), false);
+    const MarkedIncidence incidence(triangles, check, removed);
+    std::vector<std::uint32_t> drop;
     for (std::size_t slot = 0; slot < incidence.vertices().size(); ++slot) {
       const VertexIndex v = incidence.vertices()[slot];
       if (incidence.atSlot(slot).size() < 2)
@@ -127,16 +135,20 @@ std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_co
         if (f != keep)
           for (std::uint32_t t : fans[f])
             if (!isFixed(t))
-              drop[t] = changed = true;
+              drop.push_back(t);
     }
-    if (changed) {
+    if (!drop.empty()) {
+      changed = any_removed = true;
       std::fill(check.begin(), check.end(), false);
-      dropTriangles(triangles, drop, check, edges);
-      for (VertexIndex v = 0; v < check.size(); ++v)
-        if (check[v])
-          touched[v] = true;
+      for (std::uint32_t t : drop) {
+        removed[t] = true;
+        for (VertexIndex v : triangles[t])
+          check[v] = touched[v] = true;
+      }
     }
   }
+  if (any_removed)
+    dropTriangles(triangles, removed, touched, edges);
   return before - triangles.size();
 }
 

@@ -57,6 +57,8 @@ struct MeshEdges {
   /// Its capacity matches the triangle list's, so that addFilling can grow
   /// it in place.
   std::vector<std::uint32_t> neighbours;
+  /// Whether some edge has three triangles or more (no slots hold them).
+  bool crowded = false;
 };
 
 /// Scans every edge of `triangles` once. The (edge, triangle) incidences are

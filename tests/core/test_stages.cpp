@@ -572,6 +572,7 @@ void expectSameEdges(const detail::MeshEdges &found, const detail::MeshEdges &ex
   EXPECT_EQ(found.boundary, expected.boundary);
   EXPECT_EQ(found.boundary_triangle, expected.boundary_triangle);
   EXPECT_TRUE(found.neighbours == expected.neighbours);
+  EXPECT_EQ(found.crowded, expected.crowded);
 }
 
 } // namespace
