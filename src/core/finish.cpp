@@ -106,6 +106,7 @@ MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_neighbours
   struct Boundary {
     std::vector<EdgeKey> keys;
     std::vector<std::uint32_t> triangles;
+    bool crowded = false; // an edge with three triangles or more
   };
   std::vector<Boundary> parts(parts_per_block);
   std::vector<EdgeUse> uses;
@@ -137,6 +138,7 @@ MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_neighbours
       Boundary &boundary = parts[part];
       boundary.keys.clear();
       boundary.triangles.clear();
+      boundary.crowded = false;
       const VertexIndex first_low = static_cast<VertexIndex>(begin + block_vertices * part /
                                                                          parts_per_block),
                         last_low = static_cast<VertexIndex>(begin + block_vertices * (part + 1) /
@@ -151,16 +153,21 @@ MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_neighbours
           if (j - i == 1) {
             boundary.keys.push_back(key);
             boundary.triangles.push_back(uses[i].triangle);
-          } else if (j - i == 2 && with_neighbours) {
-            const std::uint32_t t = uses[i].triangle, u = uses[i + 1].triangle;
-            edges.neighbours[3 * std::size_t{t} + slotOf(triangles[t], key)] = u;
-            edges.neighbours[3 * std::size_t{u} + slotOf(triangles[u], key)] = t;
+          } else if (j - i == 2) {
+            if (with_neighbours) {
+              const std::uint32_t t = uses[i].triangle, u = uses[i + 1].triangle;
+              edges.neighbours[3 * std::size_t{t} + slotOf(triangles[t], key)] = u;
+              edges.neighbours[3 * std::size_t{u} + slotOf(triangles[u], key)] = t;
+            }
+          } else {
+            boundary.crowded = true;
           }
           i = j;
         }
       }
     });
     for (const Boundary &boundary : parts) {
+      edges.crowded = edges.crowded || boundary.crowded;
       edges.boundary.insert(edges.boundary.end(), boundary.keys.begin(), boundary.keys.end());
       edges.boundary_triangle.insert(edges.boundary_triangle.end(), boundary.triangles.begin(),
                                      boundary.triangles.end());
@@ -223,7 +230,9 @@ void addFilling(MeshEdges &edges, const std::vector<Triangle> &triangles, std::s
       link(uses[j - 1].triangle, first);
     } else if (count == 1) {
       opened.emplace_back(uses[i].key, uses[i].triangle);
-    } // three or more: not manifold, no neighbours
+    } else {
+      edges.crowded = true; // three or more: not manifold, no neighbours
+    }
     i = j;
   }
   // Each relinked triangle's slots back in the order of the edges' keys.
@@ -248,19 +257,9 @@ void addFilling(MeshEdges &edges, const std::vector<Triangle> &triangles, std::s
 
 bool dropFromMeshEdges(MeshEdges &edges, const std::vector<Triangle> &triangles,
                        const std::vector<bool> &drop) {
-  // Every incidence is a boundary edge's or one of a manifold pair's, unless
-  // some edge has three triangles or more.
-  const std::size_t count = triangles.size();
-  const std::size_t paired = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, 3 * count, 1 << 14), std::size_t{0},
-      [&](const tbb::blocked_range<std::size_t> &range, std::size_t found) {
-        for (std::size_t slot = range.begin(); slot != range.end(); ++slot)
-          found += edges.neighbours[slot] != no_neighbour;
-        return found;
-      },
-      [](std::size_t a, std::size_t b) { return a + b; });
-  if (paired + edges.boundary.size() != 3 * count)
+  if (edges.crowded)
     return false;
+  const std::size_t count = triangles.size();
   std::vector<std::uint32_t> dropped;
   for (std::uint32_t t = 0; t < count; ++t)
     if (drop[t])
