@@ -324,11 +324,11 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
   if (any_twisted) {
     // Kruskal's forest after the flat edges does not depend on their order
     // when no cycle of flat edges is twisted: the same triangles end up
-    // together with the same relative flips. So they are joined unsorted, as
-    // met, and only the few bent edges are kept and sorted; the bending is
-    // computed a block of triangles at a time, never stored for every edge
-    // (at 10M points that was 240 MB). A twist among flat edges needs
-    // Kruskal's order throughout. Ties are broken by the edge's key.
+    // together with the same relative flips. So they are joined unsorted, in
+    // parallel (ParallelJoins), and only the few bent edges are kept and
+    // sorted; the bending is computed as the edges come, never stored for
+    // every edge (at 10M points that was 240 MB). A twist among flat edges
+    // needs Kruskal's order throughout. Ties are broken by the edge's key.
     forest = ParityForest(count);
     struct BentEdge {
       double bending;

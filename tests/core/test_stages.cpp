@@ -721,8 +721,9 @@ TEST(Finish, DropUpdateMatchesANewEdgeScan) {
   }
 }
 
-// The bow-tie split keeps the edge scan it is given up to date through
-// each of its rounds (the example of BowTies.SplitKeepsTheLargerFan...).
+// The bow-tie split keeps the edge scan it is given up to date: it takes
+// what its two rounds remove out of the list at the end (the example of
+// BowTies.SplitKeepsTheLargerFan...).
 TEST(Finish, BowTieSplitKeepsTheEdgeScanUpToDate) {
   std::vector<Triangle> triangles = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4},  {0, 5, 6},
                                      {0, 6, 7}, {7, 8, 9}, {7, 9, 10}, {6, 7, 11}};

@@ -22,7 +22,8 @@ using DisjointSets = boost::disjoint_sets_with_storage<>;
 
 /// Union-find that keeps each element's flip relative to its root. The
 /// smaller index is always the root, so a set's root is its first element
-/// whatever order the joins come in.
+/// whatever order the joins come in. Threads may join and find in sets that
+/// no other thread touches: each call writes only its sets' entries.
 class ParityForest {
 public:
   enum class Join { joined, consistent, conflict };
@@ -49,12 +50,6 @@ public:
       t = next;
     }
     return {root, flip};
-  }
-
-  /// Starts fetching t's entries, which a find or join soon reads.
-  void prefetch(std::uint32_t t) const {
-    __builtin_prefetch(&parent_[t]);
-    __builtin_prefetch(&flip_to_parent_[t]);
   }
 
   /// Puts t and u in one set with their flips differing by must_differ; when
