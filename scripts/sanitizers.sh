@@ -110,6 +110,6 @@ cmake --build build-tsan -j"${JOBS}" --target pcl_ms_tests pcl_ms_core_tests
 # prepared or meshed in parts takes 2 to 10 minutes a test under TSan (TBB's
 # sorts and loops) and is left out.
 ./build-tsan/pcl_ms_core_tests \
-  --gtest_filter='Finish.*:PrepareTogether.TooFew*:BucketsByOwner.FewPoints*:BucketsByOwner.NoBucket*:BucketsByOwner.OnePiece*'
+  --gtest_filter='Finish.*:Threads.*:PrepareTogether.TooFew*:BucketsByOwner.FewPoints*:BucketsByOwner.NoBucket*:BucketsByOwner.OnePiece*'
 ./build-tsan/pcl_ms_tests --gtest_filter='TimeLimit*.*:FuzzCorpus.*:BucketExchange.*:Buckets.AutomaticChoiceDependsOnTheCloudSizeOnly:Buckets.InvalidBucketParametersAreRejected:Buckets.OneUnitKeepsOnlyTrianglesOnItsCorePoints'
 echo "sanitizers: ASan/UBSan tests, fuzzing and TSan tests passed"

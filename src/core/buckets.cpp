@@ -11,10 +11,6 @@
 #include "median_spacing.h"
 #include "threads.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -246,7 +242,6 @@ public:
     for (std::size_t leaf = 0; leaf < spacings.size(); ++leaf)
       leaf_margin_[leaf] = detail::bucketMargin(parameters_.rho, spacings[leaf]);
 
-    tbb::task_arena arena = detail::threadArena(parameters_.num_threads);
     Clock::time_point stage = Clock::now();
     surface_.local_scale.assign(points_.size(), 0.0f);
     std::vector<BucketOutcome> leaf_outcomes(leaves.size());
@@ -265,15 +260,15 @@ public:
             progress.unitDone();
           });
     } else {
-      arena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, own_leaves.size(), 1),
-                          [&](const tbb::blocked_range<std::size_t> &range) {
-                            for (std::size_t k = range.begin(); k != range.end(); ++k) {
-                              const std::size_t i = own_leaves[k];
-                              margin_points[i] = meshLeaf(nodes[leaves[i]], leaf_outcomes[i]);
-                              progress.unitDone();
-                            }
-                          });
+      detail::withThreads(parameters_.num_threads, [&] {
+        detail::parallelFor(tbb::blocked_range<std::size_t>(0, own_leaves.size(), 1),
+                            [&](const tbb::blocked_range<std::size_t> &range) {
+                              for (std::size_t k = range.begin(); k != range.end(); ++k) {
+                                const std::size_t i = own_leaves[k];
+                                margin_points[i] = meshLeaf(nodes[leaves[i]], leaf_outcomes[i]);
+                                progress.unitDone();
+                              }
+                            });
       });
     }
     // Per leaf: d_med, failed, margin points; only the owner's are non-zero.
@@ -345,14 +340,14 @@ public:
           progress.unitDone();
         }
       } else {
-        arena.execute([&] {
-          tbb::parallel_for(tbb::blocked_range<std::size_t>(0, level.size(), 1),
-                            [&](const tbb::blocked_range<std::size_t> &range) {
-                              for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                                zone_points[i] = stitch(nodes[level[i]], outcomes[i]);
-                                progress.unitDone();
-                              }
-                            });
+        detail::withThreads(parameters_.num_threads, [&] {
+          detail::parallelFor(tbb::blocked_range<std::size_t>(0, level.size(), 1),
+                              [&](const tbb::blocked_range<std::size_t> &range) {
+                                for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                                  zone_points[i] = stitch(nodes[level[i]], outcomes[i]);
+                                  progress.unitDone();
+                                }
+                              });
         });
       }
       for (std::size_t i = 0; i < level.size(); ++i) {

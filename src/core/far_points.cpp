@@ -2,8 +2,7 @@
 // Stray points (docs/algorithm.md section 1). In: distinct points. Out: the
 // points far from the rest, and a centre they cannot move.
 #include "far_points.h"
-
-#include <tbb/parallel_for.h>
+#include "threads.h"
 
 #include <algorithm>
 #include <cmath>
@@ -73,7 +72,7 @@ FarPoints findFarPoints(const std::vector<Eigen::Vector3f> &points) {
   const std::size_t tail = tailRank(n);
   Eigen::Vector3d central_low, central_high;
   // The axes are independent selections: one thread each.
-  tbb::parallel_for(0, 3, [&](int axis) {
+  parallelFor(0, 3, [&](std::size_t axis) {
     std::vector<float> values(n);
     for (std::size_t i = 0; i < n; ++i)
       values[i] = points[i][axis];
@@ -105,7 +104,7 @@ FarPoints findFarPoints(const std::vector<Eigen::Vector3f> &points) {
     }
 
   // The median of the points kept, so that far points change nothing.
-  tbb::parallel_for(0, 3, [&](int axis) {
+  parallelFor(0, 3, [&](std::size_t axis) {
     std::vector<float> values;
     values.reserve(n - far.count);
     for (std::size_t i = 0; i < n; ++i)

@@ -5,8 +5,6 @@
 // are in hole_filling.cpp, orientation.cpp, bow_ties.cpp; this file drives them.
 #include "finish_steps.h"
 
-#include <tbb/parallel_reduce.h>
-
 #include <algorithm>
 #include <array>
 #include <utility>
@@ -78,7 +76,7 @@ MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_neighbours
   // for a block of lower vertices at a time. Threads file them in any order
   // and the sort settles it, so the result does not depend on the threads.
   const std::size_t count = triangles.size();
-  const VertexIndex vertex_count = tbb::parallel_reduce(
+  const VertexIndex vertex_count = parallelReduce(
       tbb::blocked_range<std::size_t>(0, count, 1 << 12), VertexIndex{0},
       [&](const tbb::blocked_range<std::size_t> &range, VertexIndex highest) {
         for (std::size_t t = range.begin(); t != range.end(); ++t)
@@ -134,7 +132,7 @@ MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_neighbours
       std::sort(uses.begin() + static_cast<std::ptrdiff_t>(offsets[begin + i] - base),
                 uses.begin() + static_cast<std::ptrdiff_t>(offsets[begin + i + 1] - base));
     });
-    tbb::parallel_for(std::size_t(0), parts_per_block, [&](std::size_t part) {
+    parallelFor(std::size_t(0), parts_per_block, [&](std::size_t part) {
       Boundary &boundary = parts[part];
       boundary.keys.clear();
       boundary.triangles.clear();

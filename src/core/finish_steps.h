@@ -6,11 +6,9 @@
 #pragma once
 
 #include "edge_key.h"
+#include "threads.h"
 
 #include <pcl_ms/finish.h>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <Eigen/Core>
 
@@ -21,15 +19,15 @@ namespace pcl_ms {
 namespace detail {
 
 /// Calls work(i) for every i in [0, count), in parallel within the caller's
-/// task arena. Each call must touch only its own outputs, so the result does
-/// not depend on the number of threads.
+/// threads (threads.h). Each call must touch only its own outputs, so the
+/// result does not depend on the number of threads.
 template <typename Work> void forEachIndex(std::size_t count, const Work &work) {
   constexpr std::size_t grain = 1 << 12;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, grain),
-                    [&](const tbb::blocked_range<std::size_t> &range) {
-                      for (std::size_t i = range.begin(); i != range.end(); ++i)
-                        work(i);
-                    });
+  parallelFor(tbb::blocked_range<std::size_t>(0, count, grain),
+              [&](const tbb::blocked_range<std::size_t> &range) {
+                for (std::size_t i = range.begin(); i != range.end(); ++i)
+                  work(i);
+              });
 }
 
 inline constexpr std::uint32_t no_neighbour = 0xffffffffu;

@@ -126,7 +126,7 @@ public:
     // The few edges between ranges (1 % of a 1M-point surface's), listed
     // once: finding them by a scan of every triangle cost each call as
     // much as joining all the others in parallel.
-    tbb::parallel_for(std::size_t(0), ranges_, [&](std::size_t range) {
+    parallelFor(std::size_t(0), ranges_, [&](std::size_t range) {
       forEachEdgeOf(range, [&](std::uint32_t t, std::uint32_t u, bool within) {
         if (!within)
           between_[range].emplace_back(t, u);
@@ -139,7 +139,7 @@ public:
 
   /// Calls join(t, u, part) for every edge.
   template <typename Join> void forEachEdge(const Join &join) const {
-    tbb::parallel_for(std::size_t(0), ranges_, [&](std::size_t range) {
+    parallelFor(std::size_t(0), ranges_, [&](std::size_t range) {
       forEachEdgeOf(range, [&](std::uint32_t t, std::uint32_t u, bool within) {
         if (within)
           join(t, u, range);

@@ -11,8 +11,7 @@
 #include "far_points.h"
 #include "point_keys.h"
 #include "process_bytes.h"
-
-#include <tbb/parallel_sort.h>
+#include "threads.h"
 
 #include <algorithm>
 #include <array>
@@ -187,7 +186,7 @@ const detail::PointKey &keyOf(const KeyedNormal &item) { return item.key; }
 template <typename Item>
 std::vector<Item> sortTogether(std::vector<Item> items, ProcessGroup &group) {
   const auto byKey = [](const Item &a, const Item &b) { return keyOf(a) < keyOf(b); };
-  tbb::parallel_sort(items.begin(), items.end(), byKey);
+  detail::parallelSort(items.begin(), items.end(), byKey);
   const auto processes = static_cast<std::size_t>(group.processes());
   if (processes == 1)
     return items;
@@ -219,7 +218,7 @@ std::vector<Item> sortTogether(std::vector<Item> items, ProcessGroup &group) {
   std::vector<Item>().swap(items);
   std::vector<Item> mine = valuesOf<Item>(group.exchange(outgoing));
   outgoing.clear();
-  tbb::parallel_sort(mine.begin(), mine.end(), byKey); // runs from each process, each sorted
+  detail::parallelSort(mine.begin(), mine.end(), byKey); // runs from each process, each sorted
   return mine;
 }
 

@@ -14,14 +14,13 @@
 #include "point_keys.h"
 #include "threads.h"
 
-#include <tbb/parallel_sort.h>
-
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <tuple>
@@ -174,7 +173,7 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
   }
   records.clear();
   records.shrink_to_fit();
-  tbb::parallel_sort(keys.begin(), keys.end()); // keys are distinct: one order
+  detail::parallelSort(keys.begin(), keys.end(), std::less<>()); // keys are distinct: one order
 
   PreparedPoints prepared;
   if (map_records)
@@ -396,7 +395,7 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
   const Deadline deadline(parameters.time_limit_seconds);
   Result result;
   Clock::time_point stage = Clock::now();
-  const PreparedPoints prepared = detail::threadArena(parameters.num_threads).execute([&] {
+  const PreparedPoints prepared = detail::withThreads(parameters.num_threads, [&] {
     return preparePoints(points, parameters.use_normals, !initial_triangles.empty(), result);
   });
   result.timings.prepare = secondsSince(stage);
@@ -508,7 +507,7 @@ Result meshPrepared(const PreparedPoints &prepared, const std::vector<Triangle> 
   // just them kept 14 more on CGAL's cow soup but left the cow one-sided.
   // The finish stage's parallel loops use the threads the user allowed.
   FinishedSurface surface;
-  detail::threadArena(parameters.num_threads).execute([&] {
+  detail::withThreads(parameters.num_threads, [&] {
     surface =
         finishSurface(std::move(triangles), prepared.positions, parameters.fill_holes_max_edges,
                       SideLimit{&local_scale, parameters.rho}, fixed.empty() ? nullptr : &fixed,

@@ -11,8 +11,6 @@
 #include "indexed_delaunay.h"
 #include "threads.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -167,18 +165,11 @@ std::size_t chunkCount(std::size_t items) {
 
 template <typename ChunkWork>
 void forEachChunk(std::size_t items, int num_threads, const ChunkWork &work) {
-  const std::size_t chunks = chunkCount(items);
-  auto run = [&] {
-    tbb::parallel_for(std::size_t(0), chunks, [&](std::size_t chunk) {
+  detail::withThreads(num_threads, [&] {
+    detail::parallelFor(std::size_t(0), chunkCount(items), [&](std::size_t chunk) {
       work(chunk, chunk * cells_per_chunk, std::min(items, (chunk + 1) * cells_per_chunk));
     });
-  };
-  if (num_threads == 1) {
-    for (std::size_t chunk = 0; chunk < chunks; ++chunk)
-      work(chunk, chunk * cells_per_chunk, std::min(items, (chunk + 1) * cells_per_chunk));
-    return;
-  }
-  detail::threadArena(num_threads).execute(run);
+  });
 }
 
 /// The median of [first, last), reordering it; 0 when empty.

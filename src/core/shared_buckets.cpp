@@ -18,9 +18,6 @@
 #include "shared_tree.h"
 #include "threads.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -260,37 +257,37 @@ private:
     // to go back to the points' homes.
     std::vector<std::vector<ScaleFor>> scales_of(own_leaves_.size());
     std::vector<std::vector<IndexFor>> pinches_of(own_leaves_.size());
-    detail::threadArena(parameters_.num_threads).execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, own_leaves_.size(), 1),
-                        [&](const tbb::blocked_range<std::size_t> &range) {
-                          for (std::size_t k = range.begin(); k != range.end(); ++k) {
-                            std::vector<PointRecord> &points = members[k];
-                            std::sort(points.begin(), points.end(),
-                                      [](const PointRecord &a, const PointRecord &b) {
-                                        return a.index < b.index;
-                                      });
-                            BucketTask task = taskOf(points);
-                            task.core.resize(points.size());
-                            for (std::size_t i = 0; i < points.size(); ++i)
-                              task.core[i] = points[i].leaf == own_leaves_[k];
-                            BucketOutcome &outcome = outcomes[k];
-                            outcome = meshBucket(task, parameters_, deadline_);
-                            task = BucketTask();
-                            leaf_triangles_[k] = toGlobal(outcome.triangles, points);
-                            if (!outcome.local_scale.empty())
-                              for (std::size_t i = 0; i < points.size(); ++i)
-                                if (points[i].leaf == own_leaves_[k])
-                                  scales_of[k].push_back({points[i].index, outcome.local_scale[i]});
-                            for (VertexIndex v : outcome.cut_vertices)
-                              pinches_of[k].push_back({points[v].index, 0});
-                            // Only the figures stay: the bucket's points and arrays go.
-                            std::vector<PointRecord>().swap(points);
-                            outcome.triangles = {};
-                            outcome.local_scale = {};
-                            outcome.cut_vertices = {};
-                            progress.unitDone();
-                          }
-                        });
+    detail::withThreads(parameters_.num_threads, [&] {
+      detail::parallelFor(
+          tbb::blocked_range<std::size_t>(0, own_leaves_.size(), 1),
+          [&](const tbb::blocked_range<std::size_t> &range) {
+            for (std::size_t k = range.begin(); k != range.end(); ++k) {
+              std::vector<PointRecord> &points = members[k];
+              std::sort(
+                  points.begin(), points.end(),
+                  [](const PointRecord &a, const PointRecord &b) { return a.index < b.index; });
+              BucketTask task = taskOf(points);
+              task.core.resize(points.size());
+              for (std::size_t i = 0; i < points.size(); ++i)
+                task.core[i] = points[i].leaf == own_leaves_[k];
+              BucketOutcome &outcome = outcomes[k];
+              outcome = meshBucket(task, parameters_, deadline_);
+              task = BucketTask();
+              leaf_triangles_[k] = toGlobal(outcome.triangles, points);
+              if (!outcome.local_scale.empty())
+                for (std::size_t i = 0; i < points.size(); ++i)
+                  if (points[i].leaf == own_leaves_[k])
+                    scales_of[k].push_back({points[i].index, outcome.local_scale[i]});
+              for (VertexIndex v : outcome.cut_vertices)
+                pinches_of[k].push_back({points[v].index, 0});
+              // Only the figures stay: the bucket's points and arrays go.
+              std::vector<PointRecord>().swap(points);
+              outcome.triangles = {};
+              outcome.local_scale = {};
+              outcome.cut_vertices = {};
+              progress.unitDone();
+            }
+          });
     });
     std::vector<std::vector<ScaleFor>> scales(processes);
     std::vector<std::vector<IndexFor>> pinches(processes);
@@ -529,14 +526,14 @@ private:
     std::vector<std::vector<PointRecord>> members(mine.size());
     std::vector<std::vector<bool>> core(mine.size());
     std::vector<std::size_t> core_points(mine.size(), 0);
-    detail::threadArena(parameters_.num_threads).execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mine.size(), 1),
-                        [&](const tbb::blocked_range<std::size_t> &range) {
-                          for (std::size_t k = range.begin(); k != range.end(); ++k)
-                            outcomes[k] =
-                                stitch(level[mine[k]], zone_points[mine[k]], frozen_points[mine[k]],
-                                       fixed[mine[k]], members[k], core[k], core_points[k]);
-                        });
+    detail::withThreads(parameters_.num_threads, [&] {
+      detail::parallelFor(tbb::blocked_range<std::size_t>(0, mine.size(), 1),
+                          [&](const tbb::blocked_range<std::size_t> &range) {
+                            for (std::size_t k = range.begin(); k != range.end(); ++k)
+                              outcomes[k] = stitch(level[mine[k]], zone_points[mine[k]],
+                                                   frozen_points[mine[k]], fixed[mine[k]],
+                                                   members[k], core[k], core_points[k]);
+                          });
     });
     std::vector<std::vector<IndexFor>> pinches(processes);
     for (std::size_t k = 0; k < mine.size(); ++k) {

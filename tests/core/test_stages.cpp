@@ -3,6 +3,7 @@
 #include "core_test_support.h"
 #include "fan_choice.h"
 #include "finish_steps.h"
+#include "threads.h"
 
 #include <pcl_ms/costs.h>
 #include <pcl_ms/finish.h>
@@ -11,7 +12,6 @@
 #include <pcl_ms/scaffold.h>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <map>
@@ -599,7 +599,7 @@ TEST(Finish, EdgeScanDoesNotDependOnTheBlockSize) {
       }
   // Threads file the incidences in any order: one thread must find the same.
   detail::MeshEdges one_thread;
-  tbb::task_arena(1).execute([&] { one_thread = detail::meshEdges(triangles, true); });
+  detail::withThreads(1, [&] { one_thread = detail::meshEdges(triangles, true); });
   expectSameEdges(one_thread, whole);
   for (std::size_t block : {std::size_t(1000), std::size_t(77777)}) {
     SCOPED_TRACE(block);
@@ -879,7 +879,7 @@ TEST(Finish, SameSurfaceForAnyNumberOfThreads) {
   const std::vector<float> unit_scale(points.size(), 1.0f);
   auto finishWith = [&](int threads) {
     FinishedSurface surface;
-    tbb::task_arena(threads).execute([&] {
+    detail::withThreads(threads, [&] {
       surface = finishSurface(band, points, 8, SideLimit{&unit_scale, 10.0});
     });
     return surface;

@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The core's thread helpers (src/core/threads.h): one thread runs every loop
+// on the caller without starting TBB; more threads run them in TBB's arena.
+#include "core_test_support.h"
+#include "threads.h"
+
+#include <link.h>
+
+#include <atomic>
+#include <cstring>
+#include <numeric>
+#include <thread>
+#include <vector>
+
+using namespace pcl_ms;
+
+namespace {
+
+/// Whether TBB's allocator library is loaded: TBB loads it when it starts.
+bool tbbAllocatorLoaded() {
+  bool loaded = false;
+  dl_iterate_phdr(
+      [](dl_phdr_info *info, std::size_t, void *found) {
+        if (info->dlpi_name && std::strstr(info->dlpi_name, "libtbbmalloc"))
+          *static_cast<bool *>(found) = true;
+        return 0;
+      },
+      &loaded);
+  return loaded;
+}
+
+} // namespace
+
+TEST(Threads, OneThreadRunsEveryLoopOnTheCallerInOrder) {
+  const std::thread::id caller = std::this_thread::get_id();
+  std::vector<std::size_t> order;
+  bool others = false;
+  std::vector<int> values(10000);
+  std::iota(values.rbegin(), values.rend(), 0);
+  const int sum = detail::withThreads(1, [&] {
+    EXPECT_TRUE(detail::onOneThread());
+    detail::parallelFor(std::size_t(3), std::size_t(2003), [&](std::size_t i) {
+      others |= std::this_thread::get_id() != caller;
+      order.push_back(i);
+    });
+    std::size_t calls = 0;
+    detail::parallelFor(tbb::blocked_range<std::size_t>(0, 5000, 16),
+                        [&](const tbb::blocked_range<std::size_t> &range) {
+                          ++calls;
+                          EXPECT_EQ(range.begin(), 0u);
+                          EXPECT_EQ(range.end(), 5000u);
+                        });
+    EXPECT_EQ(calls, 1u);
+    detail::parallelSort(values.begin(), values.end(), std::less<>());
+    return detail::parallelReduce(
+        tbb::blocked_range<std::size_t>(0, values.size(), 64), 0,
+        [&](const tbb::blocked_range<std::size_t> &range, int total) {
+          for (std::size_t i = range.begin(); i != range.end(); ++i)
+            total += values[i] % 7;
+          return total;
+        },
+        std::plus<>());
+  });
+  EXPECT_FALSE(others);
+  ASSERT_EQ(order.size(), 2000u);
+  for (std::size_t k = 0; k < order.size(); ++k)
+    ASSERT_EQ(order[k], k + 3);
+  EXPECT_TRUE(std::is_sorted(values.begin(), values.end()));
+  int expected = 0;
+  for (int value : values)
+    expected += value % 7;
+  EXPECT_EQ(sum, expected);
+  EXPECT_FALSE(detail::onOneThread()) << "restored after the work";
+}
+
+TEST(Threads, SeveralThreadsCoverEveryIndexOnceAndNestedOneThreadRestores) {
+  std::vector<std::atomic<int>> visits(20000);
+  std::atomic<int> nested_on_one{0}, restored{0};
+  detail::withThreads(2, [&] {
+    EXPECT_FALSE(detail::onOneThread());
+    detail::parallelFor(std::size_t(0), visits.size(), [&](std::size_t i) {
+      ++visits[i];
+      if (i % 1000 == 0) {
+        // A bucket meshed on one thread inside a parallel run.
+        detail::withThreads(1, [&] { nested_on_one += detail::onOneThread(); });
+        restored += !detail::onOneThread();
+      }
+    });
+  });
+  for (const std::atomic<int> &count : visits)
+    ASSERT_EQ(count.load(), 1);
+  EXPECT_EQ(nested_on_one.load(), 20);
+  EXPECT_EQ(restored.load(), 20);
+}
+
+// Starting TBB cost 7 ms and 4 MB in a process with PCL loaded: a whole
+// one-thread reconstruction must not start it. ctest runs each test in its
+// own process, where TBB has not started before.
+TEST(Threads, OneThreadReconstructionDoesNotStartTbb) {
+  if (tbbAllocatorLoaded())
+    GTEST_SKIP() << "TBB started earlier in this process (run the test alone)";
+  const std::vector<float> xyz = pcl_ms_test::bunnyCoordinates();
+  Parameters parameters;
+  parameters.num_threads = 1;
+  const Result one_piece = reconstruct(pcl_ms_test::viewOf(xyz), parameters);
+  EXPECT_GT(one_piece.triangles.size(), 60000u);
+  parameters.bucket_points = 10000;
+  const Result bucketed = reconstruct(pcl_ms_test::viewOf(xyz), parameters);
+  EXPECT_GT(bucketed.bucket_statistics.buckets, 1u);
+  EXPECT_GT(bucketed.triangles.size(), 60000u);
+  EXPECT_FALSE(tbbAllocatorLoaded());
+  // The check sees TBB when it does start.
+  std::atomic<int> done{0};
+  detail::withThreads(2, [&] {
+    detail::parallelFor(std::size_t(0), std::size_t(1000), [&](std::size_t) { ++done; });
+  });
+  EXPECT_EQ(done.load(), 1000);
+  EXPECT_TRUE(tbbAllocatorLoaded());
+}
