@@ -527,8 +527,10 @@ private:
         cells_.size(), options_.num_threads,
         [&](std::size_t chunk, std::size_t begin, std::size_t end) {
           ChunkCandidates &out = chunks[chunk];
-          // The facets come in the order measureLocalScales saw them in.
+          // The facets come in the order measureLocalScales saw them in, one
+          // kind each: room for all of them spares the list's regrowth.
           std::vector<FacetKind>::const_iterator kind = chunk_kinds_[chunk].begin();
+          out.candidates.reserve(chunk_kinds_[chunk].size());
           for (std::size_t index = begin; index < end; ++index) {
             if (!scaffold_.planar)
               prefetchNeighbours(cells_, index + neighbour_prefetch_distance);
