@@ -3,6 +3,7 @@
 // "Orientation", "Twists"). In: a triangle list, its manifold neighbours and the
 // points (and a viewpoint, if any). Out: each component oriented, which
 // components are orientable, and the triangles to cut where a twist is a fold.
+#include "exact_signs.h"
 #include "finish_steps.h"
 
 #include <pcl_ms/costs.h>
@@ -464,28 +465,42 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
   }
   // Outward for closed surfaces; towards the viewpoint for open ones when
   // there is one (area-weighted); a fixed, reproducible choice otherwise.
-  // Summed in triangle order, so that the sums do not depend on a walk.
-  std::vector<double> signed_volume(component_size.size(), 0.0), facing;
-  std::vector<bool> closed(component_size.size(), true);
-  if (viewpoint)
-    facing.assign(component_size.size(), 0.0);
-  for (std::uint32_t t = 0; t < count; ++t) {
-    const std::uint32_t component = triangle_component[t];
-    if (!component_orientable[component])
-      continue;
-    const Eigen::Vector3d &a = points[triangles[t][0]], &b = points[triangles[t][1]],
-                          &c = points[triangles[t][2]];
-    signed_volume[component] += a.dot(b.cross(c));
+  // The signs are the exact sums', so any order of the triangles, or of
+  // parts of them, gives them.
+  const std::size_t components = component_size.size();
+  ExactSigns signed_volume(components), facing(viewpoint ? components : 0);
+  std::vector<bool> closed(components, true);
+  auto forEachSideTerm = [&](const auto &add) {
+    for (std::uint32_t t = 0; t < count; ++t) {
+      const std::uint32_t component = triangle_component[t];
+      if (!component_orientable[component])
+        continue;
+      const Eigen::Vector3d &a = points[triangles[t][0]], &b = points[triangles[t][1]],
+                            &c = points[triangles[t][2]];
+      add(t, component, a.dot(b.cross(c)),
+          viewpoint ? (b - a).cross(c - a).dot(*viewpoint - a) : 0.0);
+    }
+  };
+  forEachSideTerm([&](std::uint32_t t, std::uint32_t component, double volume, double towards) {
+    signed_volume.add(component, volume);
     if (viewpoint)
-      facing[component] += (b - a).cross(c - a).dot(*viewpoint - a);
+      facing.add(component, towards);
     if (neighboursOf(neighbours, t).size() != 3)
       closed[component] = false;
-  }
-  std::vector<std::uint8_t> turn(component_size.size(), 0);
-  for (std::size_t component = 0; component < turn.size(); ++component)
-    turn[component] =
-        component_orientable[component] &&
-        (viewpoint && !closed[component] ? facing[component] : signed_volume[component]) < 0;
+  });
+  const bool exact_volume = signed_volume.needsExactPass();
+  const bool exact_facing = viewpoint && facing.needsExactPass();
+  if (exact_volume || exact_facing)
+    forEachSideTerm([&](std::uint32_t, std::uint32_t component, double volume, double towards) {
+      signed_volume.addExactly(component, volume);
+      if (exact_facing)
+        facing.addExactly(component, towards);
+    });
+  std::vector<std::uint8_t> turn(components, 0);
+  for (std::size_t component = 0; component < components; ++component)
+    turn[component] = component_orientable[component] &&
+                      (viewpoint && !closed[component] ? facing.sign(component)
+                                                       : signed_volume.sign(component)) < 0;
   forEachIndex(count, [&](std::size_t t) {
     if (turn[triangle_component[t]])
       std::swap(triangles[t][1], triangles[t][2]);
