@@ -4,8 +4,8 @@
 //
 // With one thread the loops run on the caller and TBB is never started:
 // starting it (its allocator, its thread pool, looking for a resource
-// manager) cost 7 ms and 4 MB in a process that had loaded PCL, a fifth of
-// meshing a 2,000-point scan (docs/algorithm.md, "Code layout", "Threads").
+// manager) cost 7 ms and 4 MB in a process that had loaded PCL, about 15 %
+// of meshing a 2,000-point scan (docs/algorithm.md, "Code layout", "Threads").
 #pragma once
 
 #include <tbb/blocked_range.h>
