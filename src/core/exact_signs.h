@@ -3,7 +3,7 @@
 // Internal to the library: not installed.
 #pragma once
 
-#include <CGAL/MP_Float.h>
+#include <CGAL/Gmpzf.h>
 
 #include <cmath>
 #include <cstddef>
@@ -18,7 +18,8 @@ namespace detail {
 /// added apart and then merged, decides alike (docs/algorithm.md, section 4,
 /// "Orientation"). The terms are added in floating point with their
 /// magnitudes; a sum within its rounding bound of zero needs a second pass
-/// that adds its terms exactly (CGAL::MP_Float).
+/// that adds its terms exactly (CGAL::Gmpzf, a GMP integer times a power of
+/// two, exact for sums of doubles).
 class ExactSigns {
 public:
   explicit ExactSigns(std::size_t sums) : rounded_(sums) {}
@@ -54,7 +55,7 @@ public:
   /// The exact pass, after needsExactPass(): the same terms again.
   void addExactly(std::size_t k, double term) {
     if (exact_slot_[k] != no_slot)
-      exact_[exact_slot_[k]] += CGAL::MP_Float(term);
+      exact_[exact_slot_[k]] += CGAL::Gmpzf(term);
   }
 
   /// Sum k's sign, once needsExactPass() has been asked (and, if it was
@@ -92,7 +93,7 @@ private:
   static constexpr std::size_t no_slot = static_cast<std::size_t>(-1);
   std::vector<Rounded> rounded_;
   std::vector<std::size_t> exact_slot_;
-  std::vector<CGAL::MP_Float> exact_;
+  std::vector<CGAL::Gmpzf> exact_;
 };
 
 } // namespace detail
