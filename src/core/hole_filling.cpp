@@ -4,6 +4,7 @@
 // small simple loops closed by minimum-cost triangulations that put no third
 // triangle on an edge.
 #include "finish_steps.h"
+#include "huge_page_allocator.h"
 
 #include <pcl_ms/costs.h>
 

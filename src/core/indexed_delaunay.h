@@ -6,6 +6,8 @@
 
 #include <pcl_ms/types.h>
 
+#include "huge_page_allocator.h"
+
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Delaunay_triangulation_cell_base_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>

@@ -8,6 +8,7 @@
 #include <pcl_ms/scaffold.h>
 
 #include "flat_cells.h"
+#include "huge_pages.h"
 #include "indexed_delaunay.h"
 #include "threads.h"
 
@@ -282,7 +283,7 @@ private:
       return;
     }
     std::uint32_t id = 0;
-    cells_.reserve(delaunay.tds().number_of_cells());
+    detail::reserveOnHugePages(cells_, delaunay.tds().number_of_cells());
     for (CellHandle cell : delaunay.all_cell_handles()) {
       cell->info() = id++;
       cells_.push_back(cell);
@@ -607,7 +608,7 @@ private:
     std::size_t total = 0;
     for (const auto &chunk : chunks)
       total += chunk.candidates.size();
-    scaffold_.candidates.reserve(total);
+    detail::reserveOnHugePages(scaffold_.candidates, total);
     // Types I and II first: pass 1 touches only them, so its working set is
     // a contiguous quarter of the candidates instead of being spread over all.
     for (bool ambiguous : {false, true})
@@ -758,7 +759,7 @@ private:
     forEachEdge([&](CandidateIndex, int, VertexIndex low, VertexIndex) { ++offsets[low + 1]; });
     std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
     std::vector<VertexIndex> &neighbours = scaffold_.edge_high_vertices;
-    neighbours.assign(offsets[n], 0);
+    detail::assignOnHugePages(neighbours, offsets[n]);
     {
       std::vector<std::uint32_t> cursor(offsets.begin(), offsets.end() - 1);
       forEachEdge([&](CandidateIndex, int, VertexIndex low, VertexIndex high) {
@@ -782,7 +783,7 @@ private:
     const std::size_t edge_count = write;
 
     // The dictionary is complete now: every edge of the graph is found.
-    scaffold_.edge_offsets.assign(edge_count + 1, 0);
+    detail::assignOnHugePages(scaffold_.edge_offsets, edge_count + 1);
     forEachEdge([&](CandidateIndex t, int k, VertexIndex low, VertexIndex high) {
       const EdgeIndex e = scaffold_.findEdge(low, high);
       candidates[t].edges[k] = e;
@@ -790,7 +791,8 @@ private:
     });
     std::partial_sum(scaffold_.edge_offsets.begin(), scaffold_.edge_offsets.end(),
                      scaffold_.edge_offsets.begin());
-    scaffold_.edge_candidates.resize(scaffold_.edge_offsets.back());
+    detail::assignOnHugePages(scaffold_.edge_candidates,
+                              static_cast<std::size_t>(scaffold_.edge_offsets.back()));
     std::vector<std::uint32_t> cursor(scaffold_.edge_offsets.begin(),
                                       scaffold_.edge_offsets.end() - 1);
     for (CandidateIndex t = 0; t < candidates.size(); ++t)
