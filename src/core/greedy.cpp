@@ -4,7 +4,6 @@
 // accepted cheapest first, with the passes' statistics. Here the passes; the
 // repairs after them in greedy_repair.cpp, opt-in seams in greedy_seams.cpp.
 #include "greedy_impl.h"
-#include "huge_pages.h"
 
 #include <pcl_ms/costs.h>
 
@@ -33,10 +32,9 @@ GreedyMesher::Impl::Impl(MedialScaffold &&scaffold, const std::vector<Eigen::Vec
                          GreedyStatistics &statistics)
     : graph_(std::move(scaffold)), scaffold_(graph_.scaffold()), candidates_(graph_.candidates()),
       points_(points), parameters_(parameters), deadline_(deadline), statistics_(statistics),
-      mesh_(scaffold_, points.size()), is_fixed_(candidates_.size(), false),
-      is_preferred_(candidates_.size(), false), multi_fan_vertex_(points.size(), false),
-      may_have_several_fans_(points.size(), false) {
-  detail::assignOnHugePages(states_, candidates_.size());
+      mesh_(scaffold_, points.size()), states_(candidates_.size()),
+      is_fixed_(candidates_.size(), false), is_preferred_(candidates_.size(), false),
+      multi_fan_vertex_(points.size(), false), may_have_several_fans_(points.size(), false) {
   for (CandidateIndex t : scaffold_.fixed)
     is_fixed_[t] = true;
   for (CandidateIndex t : scaffold_.preferred)

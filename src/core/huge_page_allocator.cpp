@@ -2,7 +2,6 @@
 // Huge-page regions for the large blocks of CGAL's triangulation containers
 // (huge_page_allocator.h; docs/algorithm.md, "Memory pages").
 #include "huge_page_allocator.h"
-#include "huge_pages.h"
 
 #include <atomic>
 #include <cstdint>
@@ -57,7 +56,9 @@ Region *mapRegion(std::size_t bytes) {
   if (aligned + bytes < start + bytes + huge_page)
     munmap(reinterpret_cast<void *>(aligned + bytes), start + huge_page - aligned);
   void *region_start = reinterpret_cast<void *>(aligned);
-  adviseHugePages(region_start, bytes);
+  // A hint: where the kernel has transparent huge pages off, the region is
+  // ordinary memory.
+  madvise(region_start, bytes, MADV_HUGEPAGE);
   regions_mapped.fetch_add(1, std::memory_order_relaxed);
   return new (region_start) Region{{1}, bytes, block_header};
 }

@@ -4,8 +4,6 @@
 // the manifold checks the greedy asks about.
 #include <pcl_ms/mesh_topology.h>
 
-#include "huge_pages.h"
-
 #include <algorithm>
 #include <cassert>
 #include <stdexcept>
@@ -14,11 +12,9 @@
 namespace pcl_ms {
 
 MeshTopology::MeshTopology(const MedialScaffold &scaffold, std::size_t vertex_count)
-    : scaffold_(scaffold), in_mesh_(scaffold.candidates.size(), false) {
-  detail::assignOnHugePages(edge_slots_, scaffold.numberOfEdges(), {no_candidate, no_candidate});
-  detail::assignOnHugePages(vertex_triangles_, vertex_count);
-  detail::assignOnHugePages(vertex_counts_, vertex_count);
-}
+    : scaffold_(scaffold), edge_slots_(scaffold.numberOfEdges(), {no_candidate, no_candidate}),
+      vertex_triangles_(vertex_count), vertex_counts_(vertex_count),
+      in_mesh_(scaffold.candidates.size(), false) {}
 
 void MeshTopology::notACorner(CandidateIndex t, VertexIndex v) {
   throw std::logic_error("MeshTopology::edgesAt: vertex " + std::to_string(v) +

@@ -8,7 +8,6 @@
 #include <pcl_ms/scaffold.h>
 
 #include "flat_cells.h"
-#include "huge_pages.h"
 #include "indexed_delaunay.h"
 #include "threads.h"
 
@@ -283,7 +282,7 @@ private:
       return;
     }
     std::uint32_t id = 0;
-    detail::reserveOnHugePages(cells_, delaunay.tds().number_of_cells());
+    cells_.reserve(delaunay.tds().number_of_cells());
     for (CellHandle cell : delaunay.all_cell_handles()) {
       cell->info() = id++;
       cells_.push_back(cell);
@@ -608,7 +607,7 @@ private:
     std::size_t total = 0;
     for (const auto &chunk : chunks)
       total += chunk.candidates.size();
-    detail::reserveOnHugePages(scaffold_.candidates, total);
+    scaffold_.candidates.reserve(total);
     // Types I and II first: pass 1 touches only them, so its working set is
     // a contiguous quarter of the candidates instead of being spread over all.
     for (bool ambiguous : {false, true})
@@ -759,7 +758,7 @@ private:
     forEachEdge([&](CandidateIndex, int, VertexIndex low, VertexIndex) { ++offsets[low + 1]; });
     std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
     std::vector<VertexIndex> &neighbours = scaffold_.edge_high_vertices;
-    detail::assignOnHugePages(neighbours, offsets[n]);
+    neighbours.assign(offsets[n], 0);
     {
       std::vector<std::uint32_t> cursor(offsets.begin(), offsets.end() - 1);
       forEachEdge([&](CandidateIndex, int, VertexIndex low, VertexIndex high) {
@@ -783,7 +782,7 @@ private:
     const std::size_t edge_count = write;
 
     // The dictionary is complete now: every edge of the graph is found.
-    detail::assignOnHugePages(scaffold_.edge_offsets, edge_count + 1);
+    scaffold_.edge_offsets.assign(edge_count + 1, 0);
     forEachEdge([&](CandidateIndex t, int k, VertexIndex low, VertexIndex high) {
       const EdgeIndex e = scaffold_.findEdge(low, high);
       candidates[t].edges[k] = e;
@@ -791,8 +790,7 @@ private:
     });
     std::partial_sum(scaffold_.edge_offsets.begin(), scaffold_.edge_offsets.end(),
                      scaffold_.edge_offsets.begin());
-    detail::assignOnHugePages(scaffold_.edge_candidates,
-                              static_cast<std::size_t>(scaffold_.edge_offsets.back()));
+    scaffold_.edge_candidates.resize(scaffold_.edge_offsets.back());
     std::vector<std::uint32_t> cursor(scaffold_.edge_offsets.begin(),
                                       scaffold_.edge_offsets.end() - 1);
     for (CandidateIndex t = 0; t < candidates.size(); ++t)

@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Huge-page regions for CGAL's triangulation containers and the core's large
-// arrays (src/core/huge_page_allocator.h, huge_pages.h).
+// Huge-page regions for CGAL's triangulation containers
+// (src/core/huge_page_allocator.h).
 #include "core_test_support.h"
 #include "huge_page_allocator.h"
-#include "huge_pages.h"
 
 #include <pcl_ms/reconstruct.h>
 
@@ -127,12 +126,6 @@ TEST(HugePages, LargeBlocksAreOnHugePagesWhereTheKernelMakesThem) {
   std::memset(block, 1, bytes);
   EXPECT_GE(hugePagesKbAt(block), 2048);
   allocator.deallocate(block, bytes);
-
-  std::vector<std::uint64_t> array;
-  detail::assignOnHugePages(array, (std::size_t(8) << 20) / sizeof(std::uint64_t),
-                            std::uint64_t(3));
-  EXPECT_EQ(array.back(), 3u);
-  EXPECT_GE(hugePagesKbAt(array.data() + array.size() / 2), 2048);
 }
 
 TEST(HugePages, ReconstructionLeavesNoRegionBehind) {
