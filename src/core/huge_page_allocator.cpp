@@ -97,6 +97,9 @@ void *placeBlock(Region *region, std::size_t bytes) {
 #if PCL_MS_HUGE_PAGE_REGIONS
 
 void *allocateFromRegion(std::size_t bytes) {
+  // More than the address space holds; rounding it up below would wrap.
+  if (bytes > std::size_t(-1) / 4)
+    throw std::bad_alloc();
   const std::size_t needed = roundUp(bytes, 64) + block_header;
   if (needed > region_bytes - block_header) {
     // A block larger than a region gets one of its own, unshared.
