@@ -28,15 +28,6 @@ template <typename Count> Count countUp(Count &count) {
   return __atomic_fetch_add(&count, Count{1}, __ATOMIC_RELAXED);
 }
 
-/// Where t's neighbour across `key` goes before the slots are packed: the
-/// edge's place among t's three edges in key order.
-std::size_t slotOf(const Triangle &t, EdgeKey key) {
-  std::size_t below = 0;
-  for (int k = 0; k < 3; ++k)
-    below += edgeKey(t[k], t[(k + 1) % 3]) < key;
-  return below;
-}
-
 /// Replaces the boundary edges of `edges` by those that `leaves(e)` keeps,
 /// with `opened` (key, triangle; sorted) merged in, in key order; every
 /// triangle number passes through `number`.
@@ -174,14 +165,7 @@ MeshEdges meshEdges(const std::vector<Triangle> &triangles, bool with_neighbours
   }
   // Each triangle's neighbours first, still in the order of the edges' keys.
   if (with_neighbours)
-    forEachIndex(count, [&](std::size_t t) {
-      std::uint32_t *slots = &edges.neighbours[3 * t];
-      std::size_t kept = 0;
-      for (std::size_t k = 0; k < 3; ++k)
-        if (slots[k] != no_neighbour)
-          slots[kept++] = slots[k];
-      std::fill(slots + kept, slots + 3, no_neighbour);
-    });
+    packSlots(edges.neighbours, no_neighbour);
   return edges;
 }
 

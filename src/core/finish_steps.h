@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -32,6 +33,29 @@ template <typename Work> void forEachIndex(std::size_t count, const Work &work) 
 
 inline constexpr std::uint32_t no_neighbour = 0xffffffffu;
 
+/// Where t's neighbour across `key` goes before its slots are packed (see
+/// MeshEdges::neighbours): the edge's place among t's three edges in key
+/// order.
+inline std::size_t slotOf(const Triangle &t, EdgeKey key) {
+  std::size_t below = 0;
+  for (int k = 0; k < 3; ++k)
+    below += edgeKey(t[k], t[(k + 1) % 3]) < key;
+  return below;
+}
+
+/// Packs each triangle's three slots (slots[3 t + k]): the neighbours
+/// first, in the order they stand, then `none`.
+template <typename Slot> void packSlots(std::vector<Slot> &slots, Slot none) {
+  forEachIndex(slots.size() / 3, [&](std::size_t t) {
+    Slot *own = &slots[3 * t];
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < 3; ++k)
+      if (own[k] != none)
+        own[kept++] = own[k];
+    std::fill(own + kept, own + 3, none);
+  });
+}
+
 /// The edge that two neighbouring triangles share, as its key.
 inline EdgeKey sharedEdge(const Triangle &first, const Triangle &second) {
   VertexIndex shared[2] = {0, 0};
@@ -40,6 +64,23 @@ inline EdgeKey sharedEdge(const Triangle &first, const Triangle &second) {
     if ((v == second[0] || v == second[1] || v == second[2]) && found < 2)
       shared[found++] = v;
   return edgeKey(shared[0], shared[1]);
+}
+
+/// Whether triangle t, as stored, runs from a to b.
+inline bool runsFromTo(const Triangle &t, VertexIndex a, VertexIndex b) {
+  for (int k = 0; k < 3; ++k)
+    if (t[k] == a && t[(k + 1) % 3] == b)
+      return true;
+  return false;
+}
+
+/// Whether neighbours t and u run their shared edge in opposite directions
+/// (agree on their orientation).
+inline bool consistentlyOriented(const Triangle &t, const Triangle &u) {
+  for (int k = 0; k < 3; ++k)
+    if (runsFromTo(u, t[(k + 1) % 3], t[k]))
+      return true;
+  return false;
 }
 
 /// What one scan of a triangle list's edges finds.

@@ -31,14 +31,6 @@ constexpr int max_local_twist_steps = 32;
 // twists left in PCL's scans closed within 109 steps (car6, root 118).
 constexpr double max_twist_steps_per_root = 2.0;
 
-/// Whether triangle t, as stored, runs from a to b.
-bool runsFromTo(const Triangle &t, VertexIndex a, VertexIndex b) {
-  for (int k = 0; k < 3; ++k)
-    if (t[k] == a && t[(k + 1) % 3] == b)
-      return true;
-  return false;
-}
-
 // Edges bending less than this (about 30 degrees) are joined before the
 // rest without sorting (see orientAlongNeighbours); any value gives the
 // same orientation, this one leaves few edges to sort on a smooth surface.
@@ -88,14 +80,6 @@ struct Neighbours {
 Neighbours neighboursOf(const std::vector<std::uint32_t> &neighbours, std::uint32_t t) {
   const std::uint32_t *first = &neighbours[3 * std::size_t{t}];
   return {first, std::find(first, first + 3, no_neighbour)};
-}
-
-/// Whether t and u run their shared edge in opposite directions.
-bool consistentlyOriented(const Triangle &t, const Triangle &u) {
-  for (int k = 0; k < 3; ++k)
-    if (runsFromTo(u, t[(k + 1) % 3], t[k]))
-      return true;
-  return false;
 }
 
 /// The manifold edges, each once (from its lower triangle t to u), for

@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -81,6 +83,27 @@ inline void expectCleanManifold(const pcl_ms::MeshTopologyReport &report) {
   EXPECT_EQ(report.degenerate_triangles, 0u);
   EXPECT_EQ(report.duplicate_triangles, 0u);
   EXPECT_EQ(report.invalid_triangles, 0u);
+}
+
+/// A strip of `segments` quads around a circle whose ends are glued with a
+/// half twist.
+inline void moebiusBand(int segments, double half_width, std::vector<Eigen::Vector3d> &points,
+                        std::vector<pcl_ms::Triangle> &triangles) {
+  for (int i = 0; i < segments; ++i) {
+    const double angle = 2 * M_PI * i / segments, twist = angle / 2;
+    for (double side : {-half_width, half_width}) {
+      const double r = 1 + side * std::cos(twist);
+      points.emplace_back(r * std::cos(angle), r * std::sin(angle), side * std::sin(twist));
+    }
+  }
+  for (int i = 0; i < segments; ++i) {
+    const pcl_ms::VertexIndex a = 2 * i, b = 2 * i + 1;
+    pcl_ms::VertexIndex c = 2 * ((i + 1) % segments), d = c + 1;
+    if (i == segments - 1)
+      std::swap(c, d); // the half twist
+    triangles.push_back({a, b, d});
+    triangles.push_back({a, d, c});
+  }
 }
 
 } // namespace pcl_ms_test

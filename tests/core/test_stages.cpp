@@ -22,6 +22,7 @@
 
 using namespace pcl_ms;
 using pcl_ms_test::expectCleanManifold;
+using pcl_ms_test::moebiusBand;
 
 namespace {
 
@@ -46,27 +47,6 @@ const Candidate *findCandidate(const MedialScaffold &scaffold, Triangle vertices
     if (candidate.vertices == vertices)
       return &candidate;
   return nullptr;
-}
-
-/// A strip of `segments` quads around a circle whose ends are glued with a
-/// half twist.
-void moebiusBand(int segments, double half_width, std::vector<Eigen::Vector3d> &points,
-                 std::vector<Triangle> &triangles) {
-  for (int i = 0; i < segments; ++i) {
-    const double angle = 2 * M_PI * i / segments, twist = angle / 2;
-    for (double side : {-half_width, half_width}) {
-      const double r = 1 + side * std::cos(twist);
-      points.emplace_back(r * std::cos(angle), r * std::sin(angle), side * std::sin(twist));
-    }
-  }
-  for (int i = 0; i < segments; ++i) {
-    const VertexIndex a = 2 * i, b = 2 * i + 1;
-    VertexIndex c = 2 * ((i + 1) % segments), d = c + 1;
-    if (i == segments - 1)
-      std::swap(c, d); // the half twist
-    triangles.push_back({a, b, d});
-    triangles.push_back({a, d, c});
-  }
 }
 
 Result runOn(const std::vector<Eigen::Vector3d> &points, Parameters parameters = {}) {

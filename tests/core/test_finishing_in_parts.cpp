@@ -1,0 +1,262 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Finishing steps over a triangle list held in parts by several processes
+// (src/core/edges_in_parts.h, src/core/components_in_parts.h): each process
+// must get exactly its share of what one process finds, for any split,
+// threads standing in for processes.
+#include "components_in_parts.h"
+#include "core_test_support.h"
+#include "edges_in_parts.h"
+#include "finish_steps.h"
+#include "thread_processes.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+using namespace pcl_ms;
+
+namespace {
+
+/// A patch of the bunny's reference mesh with holes (every 31st triangle
+/// taken out): boundary edges along its cut and round the holes, manifold
+/// edges elsewhere.
+std::vector<Triangle> holedBunnyPatch() {
+  const std::vector<Triangle> &all = pcl_ms_test::bunnyReference().triangles;
+  std::vector<Triangle> holed;
+  for (std::size_t t = 0; t < 20000; ++t)
+    if (t % 31 != 0)
+      holed.push_back(all[t]);
+  return holed;
+}
+
+std::uint64_t vertexCount() { return pcl_ms_test::bunnyReference().vertices.size(); }
+
+/// moebiusBand(), or the same band glued without the half twist.
+void moebiusBandOrRing(int segments, bool twisted, std::vector<Eigen::Vector3d> &points,
+                       std::vector<Triangle> &triangles) {
+  pcl_ms_test::moebiusBand(segments, 0.2, points, triangles);
+  if (!twisted) {
+    // The last quad joins the ends the other way round.
+    Triangle &first = triangles[triangles.size() - 2], &second = triangles.back();
+    first[2] = 1;
+    second[1] = 1;
+    second[2] = 0;
+  }
+}
+
+/// Runs the scan on `cuts.size() - 1` processes, process p holding the
+/// triangles [cuts[p], cuts[p + 1]), and checks each against one scan of
+/// the whole list.
+void expectSharesOfTheWholeScan(const std::vector<Triangle> &triangles,
+                                const std::vector<std::size_t> &cuts) {
+  const detail::MeshEdges whole = detail::meshEdges(triangles, true);
+  const int processes = static_cast<int>(cuts.size()) - 1;
+  std::vector<detail::MeshEdgesPart> parts(static_cast<std::size_t>(processes));
+  pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
+    const auto p = static_cast<std::size_t>(group.process());
+    const std::vector<Triangle> mine(triangles.begin() + static_cast<std::ptrdiff_t>(cuts[p]),
+                                     triangles.begin() + static_cast<std::ptrdiff_t>(cuts[p + 1]));
+    parts[p] = detail::meshEdgesInParts(mine, cuts[p], vertexCount(), group);
+  });
+  std::vector<std::pair<detail::EdgeKey, std::uint64_t>> boundary_of_parts;
+  for (int p = 0; p < processes; ++p) {
+    SCOPED_TRACE("process " + std::to_string(p) + " of " + std::to_string(processes));
+    const detail::MeshEdgesPart &part = parts[static_cast<std::size_t>(p)];
+    EXPECT_EQ(part.crowded, whole.crowded);
+    ASSERT_EQ(part.neighbours.size(), 3 * (cuts[p + 1] - cuts[p]));
+    for (std::size_t t = cuts[p]; t < cuts[p + 1]; ++t)
+      for (std::size_t k = 0; k < 3; ++k) {
+        const std::uint32_t expected = whole.neighbours[3 * t + k];
+        ASSERT_EQ(part.neighbours[3 * (t - cuts[p]) + k], expected == detail::no_neighbour
+                                                              ? detail::no_neighbour_in_parts
+                                                              : std::uint64_t{expected})
+            << "triangle " << t << " slot " << k;
+      }
+    ASSERT_EQ(part.boundary.size(), part.boundary_triangle.size());
+    EXPECT_TRUE(std::is_sorted(part.boundary.begin(), part.boundary.end()));
+    for (std::size_t e = 0; e < part.boundary.size(); ++e) {
+      EXPECT_GE(part.boundary_triangle[e], cuts[p]);
+      EXPECT_LT(part.boundary_triangle[e], cuts[p + 1]);
+      boundary_of_parts.emplace_back(part.boundary[e], part.boundary_triangle[e]);
+    }
+  }
+  // Together the parts hold the whole scan's boundary, each edge once.
+  std::sort(boundary_of_parts.begin(), boundary_of_parts.end());
+  ASSERT_EQ(boundary_of_parts.size(), whole.boundary.size());
+  for (std::size_t e = 0; e < whole.boundary.size(); ++e) {
+    EXPECT_EQ(boundary_of_parts[e].first, whole.boundary[e]);
+    EXPECT_EQ(boundary_of_parts[e].second, whole.boundary_triangle[e]);
+  }
+}
+
+} // namespace
+
+TEST(EdgesInParts, EachProcessGetsItsShareOfTheWholeScanForAnySplit) {
+  const std::vector<Triangle> triangles = holedBunnyPatch();
+  const std::size_t n = triangles.size();
+  {
+    const detail::MeshEdges whole = detail::meshEdges(triangles, true);
+    ASSERT_GT(whole.boundary.size(), 1000u);
+    ASSERT_FALSE(whole.crowded);
+  }
+  const std::vector<std::vector<std::size_t>> splits = {
+      {0, n},
+      {0, n / 2, n},
+      {0, n / 5, n / 5, n},        // an empty run in the middle
+      {0, 0, n / 3, 2 * n / 3, n}, // an empty first run
+      {0, 1, n - 1, n, n},         // runs of one triangle, an empty last run
+  };
+  for (const std::vector<std::size_t> &cuts : splits) {
+    SCOPED_TRACE(std::to_string(cuts.size() - 1) + " processes");
+    expectSharesOfTheWholeScan(triangles, cuts);
+  }
+}
+
+TEST(EdgesInParts, AnEdgeOfThreeTrianglesIsCrowdedOnEveryProcess) {
+  // A third triangle on an edge the patch's first two share: the edge gets
+  // no slots and is no boundary edge, as in one scan, and every process
+  // learns that the list is crowded.
+  std::vector<Triangle> triangles = holedBunnyPatch();
+  const detail::MeshEdges before = detail::meshEdges(triangles, true);
+  const std::uint32_t u = before.neighbours[3];
+  ASSERT_NE(u, detail::no_neighbour);
+  const detail::EdgeKey shared = detail::sharedEdge(triangles[1], triangles[u]);
+  VertexIndex third_corner = 0;
+  for (VertexIndex v : triangles.back())
+    if (v != detail::lowVertex(shared) && v != detail::highVertex(shared))
+      third_corner = v;
+  triangles.push_back({detail::lowVertex(shared), detail::highVertex(shared), third_corner});
+  ASSERT_TRUE(detail::meshEdges(triangles, true).crowded);
+  const std::size_t n = triangles.size();
+  expectSharesOfTheWholeScan(triangles, {0, n / 3, n});
+  expectSharesOfTheWholeScan(triangles, {0, 2, n / 2, n - 1, n});
+}
+
+TEST(EdgesInParts, RunsThatDoNotFollowEachOtherOrCornersBeyondThePointsFailOnEveryProcess) {
+  const std::vector<Triangle> triangles = holedBunnyPatch();
+  const std::size_t half = triangles.size() / 2;
+  const std::vector<Triangle> first_half(triangles.begin(),
+                                         triangles.begin() + static_cast<std::ptrdiff_t>(half));
+  const std::vector<Triangle> second_half(triangles.begin() + static_cast<std::ptrdiff_t>(half),
+                                          triangles.end());
+  // Each case: process 1's first triangle number, and the vertex count.
+  const std::vector<std::pair<std::uint64_t, std::uint64_t>> cases = {
+      {half + 1, vertexCount()}, // a gap between the runs
+      {0, vertexCount()},        // both runs from triangle 0
+      {half, 100},               // corners beyond the points
+  };
+  for (const auto &[second_first, vertex_count] : cases) {
+    std::vector<int> failed(2, 0);
+    pcl_ms_test::onThreadProcesses(2, [&](ProcessGroup &group) {
+      const int p = group.process();
+      try {
+        detail::meshEdgesInParts(p == 0 ? first_half : second_half, p == 0 ? 0 : second_first,
+                                 vertex_count, group);
+      } catch (const std::invalid_argument &) {
+        failed[static_cast<std::size_t>(p)] = 1;
+      }
+    });
+    EXPECT_EQ(failed, std::vector<int>({1, 1})) << second_first << " " << vertex_count;
+  }
+}
+
+namespace {
+
+/// The bunny patch with a fixed random third of its triangles turned over,
+/// then a Moebius band of 400 triangles (non-orientable) and a band without
+/// the twist (orientable), both on points after the bunny's. Returns the
+/// points of all.
+std::vector<Eigen::Vector3d> mixedSurfaces(std::vector<Triangle> &triangles) {
+  triangles = holedBunnyPatch();
+  std::mt19937 random(20261202);
+  for (Triangle &t : triangles)
+    if (random() % 3 == 0)
+      std::swap(t[1], t[2]);
+  std::vector<Eigen::Vector3d> points = pcl_ms_test::bunnyReference().vertices;
+  for (bool twisted : {true, false}) {
+    std::vector<Eigen::Vector3d> band_points;
+    std::vector<Triangle> band;
+    moebiusBandOrRing(200, twisted, band_points, band);
+    const auto offset = static_cast<VertexIndex>(points.size());
+    for (Triangle t : band) {
+      for (VertexIndex &v : t)
+        v += offset;
+      triangles.push_back(t);
+    }
+    points.insert(points.end(), band_points.begin(), band_points.end());
+  }
+  return points;
+}
+
+} // namespace
+
+TEST(ComponentsInParts, ComponentsTurnsAndOrientabilityAreThoseOfOneProcessForAnySplit) {
+  std::vector<Triangle> triangles;
+  const std::vector<Eigen::Vector3d> points = mixedSurfaces(triangles);
+  const std::size_t n = triangles.size();
+  // One process: the finishing's own orientation, on a copy it may turn.
+  std::vector<Triangle> oriented = triangles;
+  std::vector<std::uint32_t> component;
+  std::vector<bool> orientable;
+  detail::orientAlongNeighbours(oriented, detail::meshEdges(oriented, true).neighbours, points,
+                                component, orientable, nullptr);
+  std::vector<std::uint64_t> first_of(orientable.size(), n);
+  for (std::size_t t = 0; t < n; ++t)
+    first_of[component[t]] = std::min<std::uint64_t>(first_of[component[t]], t);
+  ASSERT_GE(orientable.size(), 3u);
+  ASSERT_EQ(std::count(orientable.begin(), orientable.end(), false), 1); // the Moebius band
+
+  const std::vector<std::vector<std::size_t>> splits = {
+      {0, n},
+      {0, n / 2, n},
+      {0, n / 5, n / 5, n - 300, n}, // the bands cut between runs
+      {0, 7, n - 399, n - 200, n - 1, n},
+  };
+  for (const std::vector<std::size_t> &cuts : splits) {
+    const int processes = static_cast<int>(cuts.size()) - 1;
+    SCOPED_TRACE(std::to_string(processes) + " processes");
+    std::vector<detail::ComponentsPart> parts(static_cast<std::size_t>(processes));
+    pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
+      const auto p = static_cast<std::size_t>(group.process());
+      const std::vector<Triangle> mine(triangles.begin() + static_cast<std::ptrdiff_t>(cuts[p]),
+                                       triangles.begin() +
+                                           static_cast<std::ptrdiff_t>(cuts[p + 1]));
+      const detail::MeshEdgesPart edges =
+          detail::meshEdgesInParts(mine, cuts[p], points.size(), group);
+      parts[p] = detail::componentsInParts(mine, cuts[p], edges, group);
+    });
+    // Per component: whether the parts' turns give the one process's
+    // triangles as they are or all turned over (a whole component may be
+    // turned outward afterwards).
+    std::map<std::uint32_t, bool> same_way;
+    for (int p = 0; p < processes; ++p) {
+      const detail::ComponentsPart &part = parts[static_cast<std::size_t>(p)];
+      ASSERT_EQ(part.component.size(), cuts[p + 1] - cuts[p]);
+      for (std::size_t t = cuts[p]; t < cuts[p + 1]; ++t) {
+        const std::size_t i = t - cuts[p];
+        const std::uint32_t c = component[t];
+        ASSERT_EQ(part.component[i], first_of[c]) << "triangle " << t;
+        ASSERT_EQ(part.orientable[i] != 0, orientable[c]) << "triangle " << t;
+        if (!orientable[c])
+          continue;
+        Triangle turned = triangles[t];
+        if (part.flipped[i])
+          std::swap(turned[1], turned[2]);
+        const bool same = turned == oriented[t];
+        if (!same) {
+          std::swap(turned[1], turned[2]);
+          ASSERT_EQ(turned, oriented[t]) << "triangle " << t; // the corners' order is kept
+        }
+        const auto [entry, added] = same_way.emplace(c, same);
+        ASSERT_EQ(entry->second, same) << "triangle " << t << " turned against its component";
+        (void)added;
+      }
+    }
+    EXPECT_EQ(same_way.size(), orientable.size() - 1);
+  }
+}
