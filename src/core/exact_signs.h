@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -22,22 +23,36 @@ namespace detail {
 /// two, exact for sums of doubles).
 class ExactSigns {
 public:
+  /// A sum's terms added so far, in floating point: what another process
+  /// sends for merging (trivially copyable).
+  struct Partial {
+    double value = 0;
+    double magnitude = 0;
+    std::uint64_t terms = 0;
+  };
+
   explicit ExactSigns(std::size_t sums) : rounded_(sums) {}
 
   void add(std::size_t k, double term) {
-    Rounded &sum = rounded_[k];
+    Partial &sum = rounded_[k];
     sum.value += term;
     sum.magnitude += std::abs(term);
     ++sum.terms;
   }
 
+  const Partial &partial(std::size_t k) const { return rounded_[k]; }
+
+  /// Adds partial sums of sum k made elsewhere.
+  void merge(std::size_t k, const Partial &other) {
+    rounded_[k].value += other.value;
+    rounded_[k].magnitude += other.magnitude;
+    rounded_[k].terms += other.terms;
+  }
+
   /// Adds another set of partial sums of the same sums.
   void merge(const ExactSigns &other) {
-    for (std::size_t k = 0; k < rounded_.size(); ++k) {
-      rounded_[k].value += other.rounded_[k].value;
-      rounded_[k].magnitude += other.rounded_[k].magnitude;
-      rounded_[k].terms += other.rounded_[k].terms;
-    }
+    for (std::size_t k = 0; k < rounded_.size(); ++k)
+      merge(k, other.rounded_[k]);
   }
 
   /// Whether some sum's sign needs addExactly() with all of its terms.
@@ -51,6 +66,9 @@ public:
       }
     return !exact_.empty();
   }
+
+  /// After needsExactPass(): whether sum k's sign needs its terms again.
+  bool needsExactly(std::size_t k) const { return exact_slot_[k] != no_slot; }
 
   /// The exact pass, after needsExactPass(): the same terms again.
   void addExactly(std::size_t k, double term) {
@@ -67,12 +85,6 @@ public:
   }
 
 private:
-  struct Rounded {
-    double value = 0;
-    double magnitude = 0;
-    std::size_t terms = 0;
-  };
-
   /// +1 or -1 when the exact sum surely has that sign, 0 otherwise. Adding
   /// n terms in any order (and in any grouping) is off the exact sum by at
   /// most gamma(n - 1) times the sum of their magnitudes, gamma(k) = k u /
@@ -81,7 +93,7 @@ private:
   /// of Numerical Algorithms", section 4.2). For n u <= 0.01 the error is
   /// then below 1.03 n u times the computed magnitude: twice n u leaves room
   /// for the rounding of the bound itself.
-  static int certainSign(const Rounded &sum) {
+  static int certainSign(const Partial &sum) {
     const double unit_roundoff = std::numeric_limits<double>::epsilon() / 2;
     const double count_roundoff = static_cast<double>(sum.terms) * unit_roundoff;
     if (count_roundoff > 0.01)
@@ -91,7 +103,7 @@ private:
   }
 
   static constexpr std::size_t no_slot = static_cast<std::size_t>(-1);
-  std::vector<Rounded> rounded_;
+  std::vector<Partial> rounded_;
   std::vector<std::size_t> exact_slot_;
   std::vector<CGAL::Gmpzf> exact_;
 };

@@ -1,17 +1,22 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Finishing steps over a triangle list held in parts by several processes
-// (src/core/edges_in_parts.h, src/core/components_in_parts.h): each process
-// must get exactly its share of what one process finds, for any split,
-// threads standing in for processes.
+// (src/core/edges_in_parts.h, components_in_parts.h, points_from_homes.h,
+// sides_in_parts.h): each process must get exactly its share of what one
+// process finds, for any split, threads standing in for processes.
 #include "components_in_parts.h"
 #include "core_test_support.h"
 #include "edges_in_parts.h"
+#include "exact_signs.h"
 #include "finish_steps.h"
+#include "points_from_homes.h"
+#include "sides_in_parts.h"
 #include "thread_processes.h"
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <random>
 #include <stdexcept>
@@ -258,5 +263,164 @@ TEST(ComponentsInParts, ComponentsTurnsAndOrientabilityAreThoseOfOneProcessForAn
       }
     }
     EXPECT_EQ(same_way.size(), orientable.size() - 1);
+  }
+}
+
+namespace {
+
+/// A closed torus of `rings` × `around` quads round the axis through
+/// `centre` along z, two triangles each, appended with its points; a fixed
+/// random half of its triangles turned over.
+void appendTorus(int rings, int around, const Eigen::Vector3d &centre,
+                 std::vector<Eigen::Vector3d> &points, std::vector<Triangle> &triangles) {
+  const auto offset = static_cast<VertexIndex>(points.size());
+  const double pi = 3.14159265358979323846;
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < around; ++j) {
+      const double u = 2 * pi * i / rings, v = 2 * pi * j / around;
+      points.push_back(centre + Eigen::Vector3d((1 + 0.3 * std::cos(v)) * std::cos(u),
+                                                (1 + 0.3 * std::cos(v)) * std::sin(u),
+                                                0.3 * std::sin(v)));
+    }
+  const auto at = [&](int i, int j) {
+    return offset + static_cast<VertexIndex>((i % rings) * around + j % around);
+  };
+  std::mt19937 random(20261203);
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < around; ++j)
+      for (Triangle t : {Triangle{at(i, j), at(i + 1, j), at(i + 1, j + 1)},
+                         Triangle{at(i, j), at(i + 1, j + 1), at(i, j + 1)}}) {
+        if (random() % 2 == 0)
+          std::swap(t[1], t[2]);
+        triangles.push_back(t);
+      }
+}
+
+/// A flat k × k grid of points in the plane x + y + z = 0, symmetric
+/// about the origin, appended with its triangles. The point reflection
+/// through the origin maps each triangle, corners in the order stored, to
+/// another, and negates its terms of the signed volume and of the facing of
+/// a viewpoint at the origin exactly, so those sums are rounding noise
+/// round an exact zero: their signs need the exact pass.
+void appendGridThroughOrigin(int k, std::vector<Eigen::Vector3d> &points,
+                             std::vector<Triangle> &triangles) {
+  const auto offset = static_cast<VertexIndex>(points.size());
+  const Eigen::Vector3d along = Eigen::Vector3d(1, -1, 0).normalized(),
+                        across = Eigen::Vector3d(1, 1, -2).normalized();
+  const double centre = (k - 1) / 2.0;
+  for (int i = 0; i < k; ++i)
+    for (int j = 0; j < k; ++j)
+      points.push_back(0.01 * ((i - centre) * along + (j - centre) * across));
+  const auto at = [&](int i, int j) { return offset + static_cast<VertexIndex>(i * k + j); };
+  for (int i = 0; i + 1 < k; ++i)
+    for (int j = 0; j + 1 < k; ++j) {
+      triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      // The reflection of the first kind at (k - 2 - i, k - 2 - j).
+      triangles.push_back({at(i + 1, j + 1), at(i, j + 1), at(i, j)});
+    }
+}
+
+} // namespace
+
+TEST(SidesInParts, TurnsAreThoseOfOneProcessForAnySplitWithOrWithoutAViewpoint) {
+  std::vector<Triangle> triangles;
+  std::vector<Eigen::Vector3d> points = mixedSurfaces(triangles);
+  appendTorus(40, 16, Eigen::Vector3d(3, 0.5, -1), points, triangles);
+  const std::size_t grid_first = triangles.size();
+  appendGridThroughOrigin(30, points, triangles);
+  const std::size_t n = triangles.size(), point_count = points.size();
+  {
+    // The grid's sums are too close to zero for their rounding bound.
+    detail::ExactSigns grid(2);
+    for (std::size_t t = grid_first; t < n; ++t) {
+      const Eigen::Vector3d &a = points[triangles[t][0]], &b = points[triangles[t][1]],
+                            &c = points[triangles[t][2]];
+      grid.add(0, a.dot(b.cross(c)));
+      grid.add(1, (b - a).cross(c - a).dot(-a));
+    }
+    ASSERT_TRUE(grid.needsExactPass());
+    ASSERT_TRUE(grid.needsExactly(0));
+    ASSERT_TRUE(grid.needsExactly(1));
+  }
+  const Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d *viewpoint :
+       {static_cast<const Eigen::Vector3d *>(nullptr), &origin}) {
+    SCOPED_TRACE(viewpoint ? "viewpoint at the origin" : "no viewpoint");
+    std::vector<Triangle> oriented = triangles;
+    std::vector<std::uint32_t> component;
+    std::vector<bool> orientable;
+    detail::orientAlongNeighbours(oriented, detail::meshEdges(oriented, true).neighbours, points,
+                                  component, orientable, viewpoint);
+    ASSERT_EQ(std::count(orientable.begin(), orientable.end(), false), 1); // the Moebius band
+    const std::vector<std::vector<std::size_t>> splits = {
+        {0, n},
+        {0, n / 2, n},
+        {0, n / 5, n / 5, grid_first + 7, n},
+        {0, 7, n - 2000, n - 899, n - 1, n},
+    };
+    for (const std::vector<std::size_t> &cuts : splits) {
+      const int processes = static_cast<int>(cuts.size()) - 1;
+      SCOPED_TRACE(std::to_string(processes) + " processes");
+      std::vector<std::vector<std::uint8_t>> turned(static_cast<std::size_t>(processes));
+      pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
+        const auto p = static_cast<std::size_t>(group.process());
+        const std::vector<Triangle> mine(triangles.begin() + static_cast<std::ptrdiff_t>(cuts[p]),
+                                         triangles.begin() +
+                                             static_cast<std::ptrdiff_t>(cuts[p + 1]));
+        // Home slices cut elsewhere than the runs, the first one empty.
+        const std::size_t home_begin = point_count * p * p / (processes * processes),
+                          home_end = point_count * (p + 1) * (p + 1) / (processes * processes);
+        const std::vector<Eigen::Vector3d> home(
+            points.begin() + static_cast<std::ptrdiff_t>(home_begin),
+            points.begin() + static_cast<std::ptrdiff_t>(home_end));
+        const detail::MeshEdgesPart edges =
+            detail::meshEdgesInParts(mine, cuts[p], point_count, group);
+        const detail::ComponentsPart components =
+            detail::componentsInParts(mine, cuts[p], edges, group);
+        const detail::CornerPoints corners =
+            detail::cornerPointsFromHomes(mine, home, home_begin, group);
+        turned[p] =
+            detail::sideTurnsInParts(mine, cuts[p], edges, components, corners, viewpoint, group);
+      });
+      for (int p = 0; p < processes; ++p) {
+        ASSERT_EQ(turned[static_cast<std::size_t>(p)].size(), cuts[p + 1] - cuts[p]);
+        for (std::size_t t = cuts[p]; t < cuts[p + 1]; ++t) {
+          if (!orientable[component[t]])
+            continue;
+          Triangle expected = triangles[t];
+          if (turned[static_cast<std::size_t>(p)][t - cuts[p]])
+            std::swap(expected[1], expected[2]);
+          ASSERT_EQ(expected, oriented[t]) << "triangle " << t;
+        }
+      }
+    }
+  }
+}
+
+TEST(SidesInParts, PointSlicesThatDoNotFollowEachOtherOrCornersBeyondThemFailOnEveryProcess) {
+  const std::vector<Triangle> triangles = holedBunnyPatch();
+  const std::vector<Eigen::Vector3d> &points = pcl_ms_test::bunnyReference().vertices;
+  const std::size_t half = points.size() / 2;
+  // Each case: where process 1's slice starts, and how many points it holds.
+  const std::vector<std::pair<std::size_t, std::size_t>> cases = {
+      {half + 1, points.size() - half - 1}, // a gap between the slices
+      {0, points.size() - half},            // both slices from point 0
+      {half, 10},                           // too few points for the corners
+  };
+  for (const auto &[second_first, second_count] : cases) {
+    std::vector<int> failed(2, 0);
+    pcl_ms_test::onThreadProcesses(2, [&](ProcessGroup &group) {
+      const int p = group.process();
+      const std::size_t begin = p == 0 ? 0 : second_first,
+                        end = p == 0 ? half : begin + second_count;
+      const std::vector<Eigen::Vector3d> home(points.begin() + static_cast<std::ptrdiff_t>(begin),
+                                              points.begin() + static_cast<std::ptrdiff_t>(end));
+      try {
+        detail::cornerPointsFromHomes(triangles, home, begin, group);
+      } catch (const std::invalid_argument &) {
+        failed[static_cast<std::size_t>(p)] = 1;
+      }
+    });
+    EXPECT_EQ(failed, std::vector<int>({1, 1})) << second_first << " " << second_count;
   }
 }
