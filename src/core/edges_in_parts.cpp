@@ -35,15 +35,8 @@ struct EdgeVerdict {
 MeshEdgesPart meshEdgesInParts(const std::vector<Triangle> &mine, std::uint64_t first,
                                std::uint64_t vertex_count, ProcessGroup &group) {
   const auto processes = static_cast<std::size_t>(group.processes());
-  // Every process checks the same gathered facts, so all fail alike rather
-  // than one leaving the others waiting in the next exchange.
-  const std::vector<std::uint64_t> counts = countsOf(mine.size(), group);
   const std::vector<std::uint64_t> firsts =
-      valuesOf<std::uint64_t>(group.gatherAll(bytesOf(&first, 1)));
-  for (std::size_t p = 0; p < processes; ++p)
-    if (firsts[p] != (p == 0 ? 0 : firsts[p - 1] + counts[p - 1]))
-      throw std::invalid_argument("meshEdgesInParts: the processes' runs of triangles do not "
-                                  "follow each other from triangle 0");
+      runFirsts(mine.size(), first, group, "meshEdgesInParts (triangles)");
   std::uint64_t outside = 0;
   for (const Triangle &t : mine)
     for (VertexIndex v : t)
@@ -54,11 +47,7 @@ MeshEdgesPart meshEdgesInParts(const std::vector<Triangle> &mine, std::uint64_t 
   const auto judgeOf = [&](EdgeKey key) {
     return static_cast<std::size_t>(std::uint64_t{lowVertex(key)} * processes / vertex_count);
   };
-  const auto holderOf = [&](std::uint64_t triangle) {
-    // The last run starting at or before it: runs before it may be empty.
-    return static_cast<std::size_t>(std::upper_bound(firsts.begin(), firsts.end(), triangle) -
-                                    firsts.begin() - 1);
-  };
+  const auto holderOf = [&](std::uint64_t triangle) { return runHolding(firsts, triangle); };
 
   std::vector<std::vector<EdgeUse>> uses_out(processes);
   for (std::size_t t = 0; t < mine.size(); ++t)

@@ -5,6 +5,7 @@
 // components are orientable, and the triangles to cut where a twist is a fold.
 #include "exact_signs.h"
 #include "finish_steps.h"
+#include "twist_bending.h"
 
 #include <pcl_ms/costs.h>
 #include <pcl_ms/disjoint_sets.h>
@@ -31,11 +32,6 @@ constexpr int max_local_twist_steps = 32;
 // twists left in PCL's scans closed within 109 steps (car6, root 118).
 constexpr double max_twist_steps_per_root = 2.0;
 
-// Edges bending less than this (about 30 degrees) are joined before the
-// rest without sorting (see orientAlongNeighbours); any value gives the
-// same orientation, this one leaves few edges to sort on a smooth surface.
-constexpr double kruskal_flat_bending = 0.5;
-
 /// Calls measure(p, q, t's apex, u's apex) for the edge pq (p the lower
 /// vertex) that t and u share.
 template <typename Measure>
@@ -59,14 +55,11 @@ double bendingAt(std::uint32_t t, std::uint32_t u, const std::vector<Triangle> &
                           [](const auto &...corners) { return bendingAngle(corners...); });
 }
 
-/// Whether the surface surely bends less than kruskal_flat_bending there:
-/// most edges are flat, and this spares them the arctangent.
-bool surelyFlatAt(std::uint32_t t, std::uint32_t u, const std::vector<Triangle> &triangles,
-                  const std::vector<Eigen::Vector3d> &points) {
-  static const double flat_tan = std::tan(kruskal_flat_bending);
-  return acrossSharedEdge(t, u, triangles, points, [](const auto &...corners) {
-    return bendsSurelyLessThan(corners..., flat_tan * flat_tan);
-  });
+/// kruskalBending() there: 0 where the surface is surely flat.
+double kruskalBendingAt(std::uint32_t t, std::uint32_t u, const std::vector<Triangle> &triangles,
+                        const std::vector<Eigen::Vector3d> &points) {
+  return acrossSharedEdge(t, u, triangles, points,
+                          [](const auto &...corners) { return kruskalBending(corners...); });
 }
 
 /// Triangle t's manifold neighbours (MeshEdges::neighbours), in the order
@@ -330,8 +323,7 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
     edges.forEachEdge([&](std::uint32_t t, std::uint32_t u, std::size_t part) {
       if (!inTwistedComponent(t))
         return;
-      const double bending =
-          surelyFlatAt(t, u, triangles, points) ? 0.0 : bendingAt(t, u, triangles, points);
+      const double bending = kruskalBendingAt(t, u, triangles, points);
       if (bending >= kruskal_flat_bending)
         bent_in_part[part].push_back(bentEdge(t, u, bending));
       else if (join(t, u) == ParityForest::Join::conflict)

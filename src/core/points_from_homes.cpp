@@ -29,15 +29,10 @@ CornerPoints cornerPointsFromHomes(const std::vector<Triangle> &mine,
                                    const std::vector<Eigen::Vector3d> &home,
                                    std::uint64_t home_first, ProcessGroup &group) {
   const auto processes = static_cast<std::size_t>(group.processes());
-  // Checked on gathered facts, so that every process fails alike.
-  const std::vector<std::uint64_t> counts = countsOf(home.size(), group);
   const std::vector<std::uint64_t> firsts =
-      valuesOf<std::uint64_t>(group.gatherAll(bytesOf(&home_first, 1)));
-  for (std::size_t p = 0; p < processes; ++p)
-    if (firsts[p] != (p == 0 ? 0 : firsts[p - 1] + counts[p - 1]))
-      throw std::invalid_argument("cornerPointsFromHomes: the processes' slices of points do not "
-                                  "follow each other from point 0");
-  const std::uint64_t point_count = firsts.back() + counts.back();
+      runFirsts(home.size(), home_first, group, "cornerPointsFromHomes (points)");
+  const std::uint64_t last_count = countsOf(home.size(), group).back();
+  const std::uint64_t point_count = firsts.back() + last_count;
 
   CornerPoints corners;
   corners.vertices.reserve(3 * mine.size());
@@ -50,11 +45,7 @@ CornerPoints cornerPointsFromHomes(const std::vector<Triangle> &mine,
   if (totalOver(beyond ? 1 : 0, group) > 0)
     throw std::invalid_argument("cornerPointsFromHomes: a triangle has a corner beyond the points");
 
-  const auto homeOf = [&](std::uint64_t vertex) {
-    // The last slice starting at or before it: slices before it may be empty.
-    return static_cast<std::size_t>(std::upper_bound(firsts.begin(), firsts.end(), vertex) -
-                                    firsts.begin() - 1);
-  };
+  const auto homeOf = [&](std::uint64_t vertex) { return runHolding(firsts, vertex); };
   std::vector<std::vector<PointRequest>> requests_out(processes);
   for (VertexIndex v : corners.vertices)
     requests_out[homeOf(v)].push_back({v, static_cast<std::uint32_t>(group.process())});

@@ -53,12 +53,8 @@ std::vector<std::uint8_t> sideTurnsInParts(const std::vector<Triangle> &mine, st
   const auto processes = static_cast<std::size_t>(group.processes());
   const std::size_t count = mine.size();
   const std::vector<std::uint64_t> firsts =
-      valuesOf<std::uint64_t>(group.gatherAll(bytesOf(&first, 1)));
-  const auto holderOf = [&](std::uint64_t triangle) {
-    // The last run starting at or before it: runs before it may be empty.
-    return static_cast<std::size_t>(std::upper_bound(firsts.begin(), firsts.end(), triangle) -
-                                    firsts.begin() - 1);
-  };
+      runFirsts(count, first, group, "sideTurnsInParts (triangles)");
+  const auto holderOf = [&](std::uint64_t triangle) { return runHolding(firsts, triangle); };
 
   // The run's orientable components, ascending.
   std::vector<std::uint64_t> held;

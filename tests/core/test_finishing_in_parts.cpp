@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Finishing steps over a triangle list held in parts by several processes
 // (src/core/edges_in_parts.h, components_in_parts.h, points_from_homes.h,
-// sides_in_parts.h): each process must get exactly its share of what one
-// process finds, for any split, threads standing in for processes.
+// sides_in_parts.h, twists_in_parts.h): each process must get exactly its
+// share of what one process finds, for any split, threads standing in for
+// processes.
 #include "components_in_parts.h"
 #include "core_test_support.h"
 #include "edges_in_parts.h"
@@ -11,9 +12,13 @@
 #include "points_from_homes.h"
 #include "sides_in_parts.h"
 #include "thread_processes.h"
+#include "twist_bending.h"
+#include "twists_in_parts.h"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <pcl_ms/costs.h>
+#include <pcl_ms/disjoint_sets.h>
 
 #include <algorithm>
 #include <cmath>
@@ -422,5 +427,156 @@ TEST(SidesInParts, PointSlicesThatDoNotFollowEachOtherOrCornersBeyondThemFailOnE
       }
     });
     EXPECT_EQ(failed, std::vector<int>({1, 1})) << second_first << " " << second_count;
+  }
+}
+
+namespace {
+
+/// Moebius bands of 200 segments (gentle: a twisted cycle of flat edges,
+/// so the forest needs Kruskal's order throughout) and of `few` segments,
+/// jittered (the twist across bent edges), a fixed random third of their
+/// triangles turned over; returns their points.
+std::vector<Eigen::Vector3d> twistedBands(int few, std::vector<Triangle> &triangles) {
+  std::vector<Eigen::Vector3d> points;
+  std::mt19937 random(20261204);
+  std::uniform_real_distribution<double> jitter(-0.02, 0.02);
+  for (const int segments : {200, few}) {
+    std::vector<Eigen::Vector3d> band_points;
+    std::vector<Triangle> band;
+    pcl_ms_test::moebiusBand(segments, 0.3, band_points, band);
+    const auto offset = static_cast<VertexIndex>(points.size());
+    for (Eigen::Vector3d &point : band_points)
+      points.push_back(segments == 200
+                           ? point
+                           : point +
+                                 Eigen::Vector3d(jitter(random), jitter(random), jitter(random)) +
+                                 Eigen::Vector3d(3, 0, 0));
+    for (Triangle t : band) {
+      for (VertexIndex &v : t)
+        v += offset;
+      if (random() % 3 == 0)
+        std::swap(t[1], t[2]);
+      triangles.push_back(t);
+    }
+  }
+  return points;
+}
+
+/// Whether some cycle of edges flatter than kruskal_flat_bending reverses
+/// orientation, in the triangles [begin, end).
+bool flatCycleTwisted(const std::vector<Triangle> &triangles,
+                      const std::vector<Eigen::Vector3d> &points, std::size_t begin,
+                      std::size_t end) {
+  const detail::MeshEdges scan = detail::meshEdges(triangles, true);
+  detail::ParityForest forest(triangles.size());
+  bool twisted = false;
+  for (std::size_t t = begin; t < end; ++t)
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t u = scan.neighbours[3 * t + k];
+      if (u == detail::no_neighbour || u <= t)
+        continue;
+      const detail::EdgeKey key = detail::sharedEdge(triangles[t], triangles[u]);
+      auto apex = [&](const Triangle &corners) {
+        for (VertexIndex v : corners)
+          if (v != detail::lowVertex(key) && v != detail::highVertex(key))
+            return v;
+        return corners[0];
+      };
+      const double bending =
+          bendingAngle(points[detail::lowVertex(key)], points[detail::highVertex(key)],
+                       points[apex(triangles[t])], points[apex(triangles[u])]);
+      if (bending < detail::kruskal_flat_bending &&
+          forest.join(static_cast<std::uint32_t>(t), u,
+                      !detail::consistentlyOriented(triangles[t], triangles[u])) ==
+              detail::ParityForest::Join::conflict)
+        twisted = true;
+    }
+  return twisted;
+}
+
+} // namespace
+
+TEST(TwistsInParts, ForestTurnsAndConflictsAreThoseOfOneProcessForAnySplit) {
+  for (const int few : {6, 9, 16}) {
+    SCOPED_TRACE("bands of 200 and " + std::to_string(few) + " segments");
+    std::vector<Triangle> triangles;
+    const std::vector<Eigen::Vector3d> points = twistedBands(few, triangles);
+    const std::size_t n = triangles.size();
+    ASSERT_TRUE(flatCycleTwisted(triangles, points, 0, 400));
+    ASSERT_FALSE(flatCycleTwisted(triangles, points, 400, n));
+    std::vector<Triangle> oriented = triangles;
+    std::vector<std::uint32_t> component;
+    std::vector<bool> orientable;
+    const std::vector<std::uint32_t> neighbours = detail::meshEdges(oriented, true).neighbours;
+    detail::orientAlongNeighbours(oriented, neighbours, points, component, orientable, nullptr);
+    ASSERT_EQ(orientable, std::vector<bool>({false, false}));
+    std::vector<detail::TwistConflict> expected_conflicts;
+    for (std::uint32_t t = 0; t < n; ++t)
+      for (std::size_t k = 0; k < 3; ++k) {
+        const std::uint32_t u = neighbours[3 * t + k];
+        if (u != detail::no_neighbour && u > t &&
+            !detail::consistentlyOriented(oriented[t], oriented[u]))
+          expected_conflicts.push_back({detail::sharedEdge(oriented[t], oriented[u]), t, u});
+      }
+    std::sort(expected_conflicts.begin(), expected_conflicts.end());
+    ASSERT_GE(expected_conflicts.size(), 2u); // at least one per band
+
+    const std::vector<std::vector<std::size_t>> splits = {
+        {0, n},
+        {0, n / 2, n},
+        {0, 133, 133, 401, n},
+        {0, 1, 399, 400, n - 3, n},
+        // Conflicts between runs: cuts right after the first and the last
+        // conflict's lower triangle.
+        {0, expected_conflicts.front().t + 1, expected_conflicts.back().t + 1, n},
+    };
+    for (const std::vector<std::size_t> &cuts : splits) {
+      const int processes = static_cast<int>(cuts.size()) - 1;
+      SCOPED_TRACE(std::to_string(processes) + " processes");
+      std::vector<detail::TwistsPart> parts(static_cast<std::size_t>(processes));
+      pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
+        const auto p = static_cast<std::size_t>(group.process());
+        const std::vector<Triangle> mine(triangles.begin() + static_cast<std::ptrdiff_t>(cuts[p]),
+                                         triangles.begin() +
+                                             static_cast<std::ptrdiff_t>(cuts[p + 1]));
+        // Home slices cut evenly, elsewhere than the runs.
+        const std::size_t home_begin = points.size() * p / processes,
+                          home_end = points.size() * (p + 1) / processes;
+        const std::vector<Eigen::Vector3d> home(
+            points.begin() + static_cast<std::ptrdiff_t>(home_begin),
+            points.begin() + static_cast<std::ptrdiff_t>(home_end));
+        const detail::MeshEdgesPart edges =
+            detail::meshEdgesInParts(mine, cuts[p], points.size(), group);
+        const detail::ComponentsPart components =
+            detail::componentsInParts(mine, cuts[p], edges, group);
+        const detail::CornerPoints corners =
+            detail::cornerPointsFromHomes(mine, home, home_begin, group);
+        parts[p] = detail::twistForestInParts(mine, cuts[p], edges, components, corners, group);
+      });
+      std::vector<detail::TwistConflict> conflicts;
+      for (int p = 0; p < processes; ++p) {
+        const detail::TwistsPart &part = parts[static_cast<std::size_t>(p)];
+        ASSERT_EQ(part.flipped.size(), cuts[p + 1] - cuts[p]);
+        for (std::size_t t = cuts[p]; t < cuts[p + 1]; ++t) {
+          Triangle turned = triangles[t];
+          if (part.flipped[t - cuts[p]])
+            std::swap(turned[1], turned[2]);
+          ASSERT_EQ(turned, oriented[t]) << "triangle " << t;
+        }
+        EXPECT_TRUE(std::is_sorted(part.conflicts.begin(), part.conflicts.end()));
+        for (const detail::TwistConflict &conflict : part.conflicts) {
+          EXPECT_GE(conflict.t, cuts[p]);
+          EXPECT_LT(conflict.t, cuts[p + 1]);
+          conflicts.push_back(conflict);
+        }
+      }
+      std::sort(conflicts.begin(), conflicts.end());
+      ASSERT_EQ(conflicts.size(), expected_conflicts.size());
+      for (std::size_t c = 0; c < conflicts.size(); ++c) {
+        EXPECT_EQ(conflicts[c].key, expected_conflicts[c].key);
+        EXPECT_EQ(conflicts[c].t, expected_conflicts[c].t);
+        EXPECT_EQ(conflicts[c].u, expected_conflicts[c].u);
+      }
+    }
   }
 }
