@@ -160,7 +160,9 @@ TEST(EdgesInParts, RunsThatDoNotFollowEachOtherOrCornersBeyondThePointsFailOnEve
       {0, vertexCount()},        // both runs from triangle 0
       {half, 100},               // corners beyond the points
   };
-  for (const auto &[second_first, vertex_count] : cases) {
+  for (const auto &one_case : cases) {
+    // Named copies: clang 14 cannot capture structured bindings.
+    const std::uint64_t second_first = one_case.first, vertex_count = one_case.second;
     std::vector<int> failed(2, 0);
     pcl_ms_test::onThreadProcesses(2, [&](ProcessGroup &group) {
       const int p = group.process();
@@ -412,7 +414,8 @@ TEST(SidesInParts, PointSlicesThatDoNotFollowEachOtherOrCornersBeyondThemFailOnE
       {0, points.size() - half},            // both slices from point 0
       {half, 10},                           // too few points for the corners
   };
-  for (const auto &[second_first, second_count] : cases) {
+  for (const auto &one_case : cases) {
+    const std::size_t second_first = one_case.first, second_count = one_case.second;
     std::vector<int> failed(2, 0);
     pcl_ms_test::onThreadProcesses(2, [&](ProcessGroup &group) {
       const int p = group.process();
