@@ -44,7 +44,8 @@ struct TwistsPart {
 /// flat ones, then along the bent ones flattest first, and answers each
 /// piece's turn. Where a cycle of flat edges is twisted the flat edges
 /// need Kruskal's order too: then every edge of the twisted components
-/// goes to process 0 (rare: a real Moebius band bends gently throughout).
+/// goes to process 0 (a real Moebius band, which bends gently throughout;
+/// a crumple's twist crosses bent edges).
 TwistsPart twistForestInParts(const std::vector<Triangle> &mine, std::uint64_t first,
                               const MeshEdgesPart &edges, const ComponentsPart &components,
                               const CornerPoints &corners, ProcessGroup &group);
