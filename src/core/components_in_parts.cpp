@@ -4,12 +4,13 @@
 #include "components_in_parts.h"
 
 #include "finish_steps.h"
+#include "pieces_in_parts.h"
 #include "process_bytes.h"
 
 #include <pcl_ms/disjoint_sets.h>
 
 #include <algorithm>
-#include <tuple>
+#include <utility>
 
 namespace pcl_ms {
 namespace detail {
@@ -45,53 +46,32 @@ std::vector<std::vector<PieceAnswer>> joinPieces(std::vector<CrossSide> &sides,
   std::vector<std::vector<PieceAnswer>> answers(processes);
   if (sides.empty())
     return answers;
-  // The pieces, numbered in order of their first triangles: the parity
-  // forest's roots are its smallest numbers, so a component's root is its
-  // first triangle, as in one process's forest.
-  std::vector<std::uint64_t> pieces;
-  pieces.reserve(sides.size());
+  // The pieces numbered, joined along the edges between them.
+  std::vector<std::uint64_t> named;
+  named.reserve(sides.size());
   for (const CrossSide &side : sides)
-    pieces.push_back(side.piece);
-  std::sort(pieces.begin(), pieces.end());
-  pieces.erase(std::unique(pieces.begin(), pieces.end()), pieces.end());
-  const auto numberOf = [&](std::uint64_t piece) {
-    return static_cast<std::uint32_t>(std::lower_bound(pieces.begin(), pieces.end(), piece) -
-                                      pieces.begin());
-  };
-  ParityForest forest(pieces.size());
-  std::vector<std::uint8_t> conflicted(pieces.size(), 0);
+    named.push_back(side.piece);
+  const PieceNumbers numberOf(std::move(named));
+  ParityForest forest(numberOf.size());
+  std::vector<std::uint8_t> conflicted(numberOf.size(), 0);
   for (const CrossSide &side : sides)
     conflicted[numberOf(side.piece)] |= side.conflicted;
-  // Each edge has a side from each run; both sides of every edge between
-  // the same two triangles sort together (two triangles on the same three
-  // corners share three edges).
-  const auto pairOf = [](const CrossSide &side) {
-    return std::make_tuple(std::min(side.triangle, side.across),
-                           std::max(side.triangle, side.across), side.triangle);
-  };
-  std::sort(sides.begin(), sides.end(),
-            [&](const CrossSide &a, const CrossSide &b) { return pairOf(a) < pairOf(b); });
-  for (std::size_t i = 0; i < sides.size();) {
-    std::size_t j = i;
-    while (j < sides.size() && std::get<0>(pairOf(sides[j])) == std::get<0>(pairOf(sides[i])) &&
-           std::get<1>(pairOf(sides[j])) == std::get<1>(pairOf(sides[i])))
-      ++j;
-    const CrossSide &low = sides[i], &high = sides[j - 1];
-    if (low.triangle != high.triangle) {
-      // t = low's triangle, u = high's: u's piece flipped by `flip` relative
-      // to t's must differ from t's by whether they disagree, as stored.
-      const bool must_differ = !consistentlyOriented(low.corners, high.corners);
-      const auto t = numberOf(low.piece), u = numberOf(high.piece);
-      if (forest.join(t, u, must_differ != (low.flip != high.flip)) == ParityForest::Join::conflict)
-        conflicted[t] = 1;
-    }
-    i = j;
-  }
-  std::vector<std::uint8_t> component_conflicted(pieces.size(), 0);
-  for (std::uint32_t p = 0; p < pieces.size(); ++p)
+  forEachTrianglePair(sides, [&](std::size_t begin, std::size_t end) {
+    const CrossSide &low = sides[begin], &high = sides[end - 1];
+    if (low.triangle == high.triangle)
+      return;
+    // t = low's triangle, u = high's: u's piece flipped by `flip` relative
+    // to t's must differ from t's by whether they disagree, as stored.
+    const bool must_differ = !consistentlyOriented(low.corners, high.corners);
+    const auto t = numberOf(low.piece), u = numberOf(high.piece);
+    if (forest.join(t, u, must_differ != (low.flip != high.flip)) == ParityForest::Join::conflict)
+      conflicted[t] = 1;
+  });
+  std::vector<std::uint8_t> component_conflicted(numberOf.size(), 0);
+  for (std::uint32_t p = 0; p < numberOf.size(); ++p)
     component_conflicted[forest.find(p).first] |= conflicted[p];
   // One answer per piece, to each process that sent a side of it.
-  std::vector<std::uint8_t> answered(pieces.size() * processes, 0);
+  std::vector<std::uint8_t> answered(numberOf.size() * processes, 0);
   for (const CrossSide &side : sides) {
     const std::uint32_t p = numberOf(side.piece);
     std::uint8_t &done = answered[std::size_t{p} * processes + side.process];
@@ -99,8 +79,8 @@ std::vector<std::vector<PieceAnswer>> joinPieces(std::vector<CrossSide> &sides,
       continue;
     done = 1;
     const auto [root, flip] = forest.find(p);
-    answers[side.process].push_back(
-        {side.piece, pieces[root], flip, static_cast<std::uint8_t>(!component_conflicted[root])});
+    answers[side.process].push_back({side.piece, numberOf.piece(root), flip,
+                                     static_cast<std::uint8_t>(!component_conflicted[root])});
   }
   return answers;
 }

@@ -4,6 +4,7 @@
 #include "twists_in_parts.h"
 
 #include "finish_steps.h"
+#include "pieces_in_parts.h"
 #include "process_bytes.h"
 #include "twist_bending.h"
 
@@ -11,7 +12,6 @@
 #include <pcl_ms/disjoint_sets.h>
 
 #include <algorithm>
-#include <tuple>
 #include <utility>
 
 namespace pcl_ms {
@@ -76,19 +76,9 @@ Eigen::Vector3d pointOf(const TwistSide &side, int k) {
 std::vector<PieceEdge> edgesOfSides(std::vector<TwistSide> &sides, bool everything_sorted,
                                     std::vector<std::pair<std::uint64_t, std::uint32_t>> &holders,
                                     std::vector<std::uint32_t> &lower_holder) {
-  const auto pairOf = [](const TwistSide &side) {
-    return std::make_tuple(std::min(side.triangle, side.across),
-                           std::max(side.triangle, side.across), side.triangle);
-  };
-  std::sort(sides.begin(), sides.end(),
-            [&](const TwistSide &a, const TwistSide &b) { return pairOf(a) < pairOf(b); });
   std::vector<PieceEdge> joined;
-  for (std::size_t i = 0; i < sides.size();) {
-    std::size_t j = i;
-    while (j < sides.size() && std::get<0>(pairOf(sides[j])) == std::get<0>(pairOf(sides[i])) &&
-           std::get<1>(pairOf(sides[j])) == std::get<1>(pairOf(sides[i])))
-      ++j;
-    const TwistSide &low = sides[i], &high = sides[j - 1];
+  forEachTrianglePair(sides, [&](std::size_t begin, std::size_t end) {
+    const TwistSide &low = sides[begin], &high = sides[end - 1];
     holders.emplace_back(low.piece, low.process);
     holders.emplace_back(high.piece, high.process);
     const EdgeKey key = sharedEdge(low.corners, high.corners);
@@ -100,14 +90,13 @@ std::vector<PieceEdge> edgesOfSides(std::vector<TwistSide> &sides, bool everythi
     const auto differ = static_cast<std::uint8_t>(!consistentlyOriented(low.corners, high.corners) ^
                                                   low.flip ^ high.flip);
     // One edge per shared edge, as the lower triangle's slots list them.
-    for (std::size_t k = i; k < j && sides[k].triangle == low.triangle; ++k) {
+    for (std::size_t k = begin; k < end && sides[k].triangle == low.triangle; ++k) {
       joined.push_back(
           {bending, key, low.triangle, high.triangle, low.piece, high.piece, differ,
            static_cast<std::uint8_t>(!everything_sorted && bending < kruskal_flat_bending)});
       lower_holder.push_back(low.process);
     }
-    i = j;
-  }
+  });
   return joined;
 }
 
@@ -213,22 +202,15 @@ TwistsPart twistForestInParts(const std::vector<Triangle> &mine, std::uint64_t f
       piece_edges.insert(piece_edges.end(), cross.begin(), cross.end());
     }
 
-    // Process 0: the pieces, numbered in order of their first triangles
-    // (the forest's roots are its smallest numbers: a component's root is
-    // its first triangle, as in one process's forest); the flat edges
-    // between them joined in any order.
-    std::vector<std::uint64_t> pieces;
+    // Process 0: the pieces numbered, the flat edges between them joined in
+    // any order.
+    std::vector<std::uint64_t> named;
     for (const PieceEdge &edge : piece_edges) {
-      pieces.push_back(edge.piece_t);
-      pieces.push_back(edge.piece_u);
+      named.push_back(edge.piece_t);
+      named.push_back(edge.piece_u);
     }
-    std::sort(pieces.begin(), pieces.end());
-    pieces.erase(std::unique(pieces.begin(), pieces.end()), pieces.end());
-    const auto numberOf = [&](std::uint64_t id) {
-      return static_cast<std::uint32_t>(std::lower_bound(pieces.begin(), pieces.end(), id) -
-                                        pieces.begin());
-    };
-    ParityForest piece_forest(pieces.size());
+    const PieceNumbers numberOf(std::move(named));
+    ParityForest piece_forest(numberOf.size());
     for (const PieceEdge &edge : piece_edges)
       if (edge.flat && piece_forest.join(numberOf(edge.piece_t), numberOf(edge.piece_u),
                                          edge.pieces_differ) == ParityForest::Join::conflict)
@@ -249,8 +231,8 @@ TwistsPart twistForestInParts(const std::vector<Triangle> &mine, std::uint64_t f
     for (std::size_t e : order)
       piece_forest.join(numberOf(piece_edges[e].piece_t), numberOf(piece_edges[e].piece_u),
                         piece_edges[e].pieces_differ);
-    std::vector<std::uint8_t> piece_flip(pieces.size());
-    for (std::uint32_t p = 0; p < pieces.size(); ++p)
+    std::vector<std::uint8_t> piece_flip(numberOf.size());
+    for (std::uint32_t p = 0; p < numberOf.size(); ++p)
       piece_flip[p] = piece_forest.find(p).second;
 
     // Answers: each piece's turn to the processes holding it, and the edges
