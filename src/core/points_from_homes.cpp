@@ -31,8 +31,7 @@ CornerPoints cornerPointsFromHomes(const std::vector<Triangle> &mine,
   const auto processes = static_cast<std::size_t>(group.processes());
   const std::vector<std::uint64_t> firsts =
       runFirsts(home.size(), home_first, group, "cornerPointsFromHomes (points)");
-  const std::uint64_t last_count = countsOf(home.size(), group).back();
-  const std::uint64_t point_count = firsts.back() + last_count;
+  const std::uint64_t point_count = firsts.back();
 
   CornerPoints corners;
   corners.vertices.reserve(3 * mine.size());

@@ -58,24 +58,26 @@ inline std::uint64_t maximumOver(std::uint64_t mine, ProcessGroup &group) {
 }
 
 /// Where each process's run of a list held in parts starts (this process's
-/// run: `count` items from number `first` on), on every process. Checked on
-/// the gathered figures, so that every process throws alike
-/// (std::invalid_argument, naming `what`) when the runs do not follow each
-/// other from item 0 in process order.
+/// run: `count` items from number `first` on), on every process, then the
+/// whole list's length. Checked on the gathered figures, so that every
+/// process throws alike (std::invalid_argument, naming `what`) when the runs
+/// do not follow each other from item 0 in process order.
 inline std::vector<std::uint64_t> runFirsts(std::uint64_t count, std::uint64_t first,
                                             ProcessGroup &group, const std::string &what) {
   const std::vector<std::uint64_t> counts = countsOf(count, group);
-  std::vector<std::uint64_t> firsts(counts.size());
+  std::vector<std::uint64_t> firsts(counts.size() + 1);
   const std::vector<unsigned char> gathered = group.gatherAll(bytesOf(&first, 1));
-  std::memcpy(firsts.data(), gathered.data(), firsts.size() * sizeof(std::uint64_t));
-  for (std::size_t p = 0; p < firsts.size(); ++p)
+  std::memcpy(firsts.data(), gathered.data(), counts.size() * sizeof(std::uint64_t));
+  for (std::size_t p = 0; p < counts.size(); ++p)
     if (firsts[p] != (p == 0 ? 0 : firsts[p - 1] + counts[p - 1]))
       throw std::invalid_argument(what + ": the processes' runs do not follow each other from 0");
+  firsts.back() = firsts[counts.size() - 1] + counts.back();
   return firsts;
 }
 
-/// The process whose run (from runFirsts) holds item `item`: the last run
-/// starting at or before it, as runs before it may be empty.
+/// The process whose run (from runFirsts) holds item `item`, below the
+/// list's length: the last run starting at or before it, as runs before it
+/// may be empty.
 inline std::size_t runHolding(const std::vector<std::uint64_t> &firsts, std::uint64_t item) {
   return static_cast<std::size_t>(std::upper_bound(firsts.begin(), firsts.end(), item) -
                                   firsts.begin() - 1);
