@@ -308,9 +308,13 @@ void appendTorus(int rings, int around, const Eigen::Vector3d &centre,
 /// through the origin maps each triangle, corners in the order stored, to
 /// another, and negates its terms of the signed volume and of the facing of
 /// a viewpoint at the origin exactly, so those sums are rounding noise
-/// round an exact zero: their signs need the exact pass.
+/// round an exact zero: their signs need the exact pass. With k odd, a
+/// `nudge` moves the middle point, at the origin, off the plane by that
+/// much: the terms at it no longer cancel, so a nudge far below the other
+/// terms' rounding makes exact sums that are not zero but still within
+/// their rounding bound.
 void appendGridThroughOrigin(int k, std::vector<Eigen::Vector3d> &points,
-                             std::vector<Triangle> &triangles) {
+                             std::vector<Triangle> &triangles, double nudge = 0) {
   const auto offset = static_cast<VertexIndex>(points.size());
   const Eigen::Vector3d along = Eigen::Vector3d(1, -1, 0).normalized(),
                         across = Eigen::Vector3d(1, 1, -2).normalized();
@@ -318,6 +322,8 @@ void appendGridThroughOrigin(int k, std::vector<Eigen::Vector3d> &points,
   for (int i = 0; i < k; ++i)
     for (int j = 0; j < k; ++j)
       points.push_back(0.01 * ((i - centre) * along + (j - centre) * across));
+  if (k % 2 == 1)
+    points[offset + static_cast<std::size_t>(k * k / 2)] += nudge * Eigen::Vector3d(1, 1, 1);
   const auto at = [&](int i, int j) { return offset + static_cast<VertexIndex>(i * k + j); };
   for (int i = 0; i + 1 < k; ++i)
     for (int j = 0; j + 1 < k; ++j) {
@@ -335,19 +341,33 @@ TEST(SidesInParts, TurnsAreThoseOfOneProcessForAnySplitWithOrWithoutAViewpoint) 
   appendTorus(40, 16, Eigen::Vector3d(3, 0.5, -1), points, triangles);
   const std::size_t grid_first = triangles.size();
   appendGridThroughOrigin(30, points, triangles);
+  const std::size_t nudged_first = triangles.size();
+  appendGridThroughOrigin(21, points, triangles, -1e-28);
   const std::size_t n = triangles.size(), point_count = points.size();
-  {
-    // The grid's sums are too close to zero for their rounding bound.
+  // Both grids' sums are too close to zero for their rounding bound; the
+  // first grid's are zero, the nudged one's not (its volume negative and
+  // its facing of the origin positive: each turns the grid in one case).
+  struct Grid {
+    std::size_t first, end;
+    int volume_sign;
+  };
+  for (const Grid &one : {Grid{grid_first, nudged_first, 0}, Grid{nudged_first, n, -1}}) {
     detail::ExactSigns grid(2);
-    for (std::size_t t = grid_first; t < n; ++t) {
-      const Eigen::Vector3d &a = points[triangles[t][0]], &b = points[triangles[t][1]],
-                            &c = points[triangles[t][2]];
-      grid.add(0, a.dot(b.cross(c)));
-      grid.add(1, (b - a).cross(c - a).dot(-a));
-    }
+    const auto forEachTerm = [&](const auto &add) {
+      for (std::size_t t = one.first; t < one.end; ++t) {
+        const Eigen::Vector3d &a = points[triangles[t][0]], &b = points[triangles[t][1]],
+                              &c = points[triangles[t][2]];
+        add(0, a.dot(b.cross(c)));
+        add(1, (b - a).cross(c - a).dot(-a));
+      }
+    };
+    forEachTerm([&](std::size_t k, double term) { grid.add(k, term); });
     ASSERT_TRUE(grid.needsExactPass());
     ASSERT_TRUE(grid.needsExactly(0));
     ASSERT_TRUE(grid.needsExactly(1));
+    forEachTerm([&](std::size_t k, double term) { grid.addExactly(k, term); });
+    ASSERT_EQ(grid.sign(0), one.volume_sign);
+    ASSERT_EQ(grid.sign(1), -one.volume_sign);
   }
   const Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d *viewpoint :
