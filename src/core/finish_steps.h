@@ -13,7 +13,9 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace pcl_ms {
@@ -133,12 +135,50 @@ std::vector<std::vector<VertexIndex>> boundaryLoops(const std::vector<EdgeKey> &
 /// (docs/algorithm.md, "Finishing"). Only simple loops; with only_around,
 /// only loops through a vertex marked there. Appends the new triangles to
 /// `added` (each of their edges is a boundary edge of `triangles` or a new
-/// edge of two of them) and returns the holes closed.
+/// edge of two of them) and returns the holes closed. The three steps
+/// below, in one process.
 std::size_t fillLoops(const std::vector<Triangle> &triangles,
                       std::vector<std::vector<VertexIndex>> loops,
                       const std::vector<Eigen::Vector3d> &points, int max_edges,
                       const SideLimit &limit, const std::vector<bool> *only_around,
                       std::vector<Triangle> &added);
+
+/// fillLoops' first step: the loops it may fill, in the order given: simple,
+/// of 3 to max_edges edges and, unless `around` is empty, through a vertex
+/// it marks.
+std::vector<std::vector<VertexIndex>> fillableLoops(std::vector<std::vector<VertexIndex>> loops,
+                                                    int max_edges,
+                                                    const std::function<bool(VertexIndex)> &around);
+
+/// fillLoops' second step: the edges (sorted, each once) and the triangles
+/// (corners sorted; sorted, each once) of `triangles` whose corners all
+/// satisfy on_loop, added to those given.
+template <typename OnLoop>
+void edgesAndTrianglesAmong(const std::vector<Triangle> &triangles, const OnLoop &on_loop,
+                            std::vector<EdgeKey> &edges, std::vector<Triangle> &corners) {
+  for (const Triangle &t : triangles) {
+    const std::array<bool, 3> on = {on_loop(t[0]), on_loop(t[1]), on_loop(t[2])};
+    for (int k = 0; k < 3; ++k)
+      if (on[k] && on[(k + 1) % 3])
+        edges.push_back(edgeKey(t[k], t[(k + 1) % 3]));
+    if (on[0] && on[1] && on[2]) {
+      Triangle sorted = t;
+      std::sort(sorted.begin(), sorted.end());
+      corners.push_back(sorted);
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+}
+
+/// fillLoops' last step, given fillableLoops' loops and the mesh's edges
+/// and triangles among their vertices.
+std::size_t fillChosenLoops(const std::vector<std::vector<VertexIndex>> &loops,
+                            const std::vector<Eigen::Vector3d> &points, const SideLimit &limit,
+                            std::vector<EdgeKey> mesh_edges, const std::vector<Triangle> &existing,
+                            std::vector<Triangle> &added);
 
 /// orientComponents() given the mesh's manifold neighbours (MeshEdges).
 std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangles,

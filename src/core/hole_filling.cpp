@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <functional>
 #include <limits>
 #include <set>
 
@@ -123,57 +124,32 @@ std::vector<Triangle> triangulateLoop(const std::vector<VertexIndex> &loop,
 
 } // namespace
 
-std::size_t fillLoops(const std::vector<Triangle> &triangles,
-                      std::vector<std::vector<VertexIndex>> loops,
-                      const std::vector<Eigen::Vector3d> &points, int max_edges,
-                      const SideLimit &limit, const std::vector<bool> *only_around,
-                      std::vector<Triangle> &added) {
-  if (max_edges < 3)
-    return 0;
+std::vector<std::vector<VertexIndex>>
+fillableLoops(std::vector<std::vector<VertexIndex>> loops, int max_edges,
+              const std::function<bool(VertexIndex)> &around) {
   // Only simple loops: a vertex met twice is a pinch the polygon DP cannot
-  // fill; with only_around, only loops that reach the marked vertices.
+  // fill; with `around`, only loops that reach the marked vertices.
   loops.erase(std::remove_if(loops.begin(), loops.end(),
                              [&](const std::vector<VertexIndex> &loop) {
+                               if (loop.size() < 3 ||
+                                   loop.size() > static_cast<std::size_t>(std::max(max_edges, 0)))
+                                 return true;
                                std::vector<VertexIndex> sorted = loop;
                                std::sort(sorted.begin(), sorted.end());
                                if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
                                  return true;
-                               return only_around &&
-                                      std::none_of(loop.begin(), loop.end(), [&](VertexIndex v) {
-                                        return (*only_around)[v];
-                                      });
+                               return around && std::none_of(loop.begin(), loop.end(), around);
                              }),
               loops.end());
-  const bool any_small_loop = std::any_of(loops.begin(), loops.end(), [&](const auto &loop) {
-    return loop.size() <= static_cast<std::size_t>(max_edges);
-  });
-  if (!any_small_loop)
-    return 0;
-  // Existing edges and triangles matter only where all their corners are
-  // on a loop that may be filled: that keeps these lists short.
-  std::vector<bool> on_small_loop(points.size(), false);
-  for (const auto &loop : loops)
-    if (loop.size() <= static_cast<std::size_t>(max_edges))
-      for (VertexIndex v : loop)
-        on_small_loop[v] = true;
-  std::vector<EdgeKey> mesh_edges;
-  for (const Triangle &t : triangles)
-    for (int k = 0; k < 3; ++k)
-      if (on_small_loop[t[k]] && on_small_loop[t[(k + 1) % 3]])
-        mesh_edges.push_back(edgeKey(t[k], t[(k + 1) % 3]));
-  std::sort(mesh_edges.begin(), mesh_edges.end());
-  mesh_edges.erase(std::unique(mesh_edges.begin(), mesh_edges.end()), mesh_edges.end());
-  std::set<std::array<VertexIndex, 3>> existing;
-  for (Triangle t : triangles)
-    if (on_small_loop[t[0]] && on_small_loop[t[1]] && on_small_loop[t[2]]) {
-      std::sort(t.begin(), t.end());
-      existing.insert(t);
-    }
+  return loops;
+}
 
+std::size_t fillChosenLoops(const std::vector<std::vector<VertexIndex>> &loops,
+                            const std::vector<Eigen::Vector3d> &points, const SideLimit &limit,
+                            std::vector<EdgeKey> mesh_edges, const std::vector<Triangle> &existing,
+                            std::vector<Triangle> &added) {
   std::size_t filled = 0;
   for (const auto &loop : loops) {
-    if (loop.size() < 3 || loop.size() > static_cast<std::size_t>(max_edges))
-      continue;
     // Any triangles where the loop's Delaunay facets cannot fill it: the
     // size limit still holds, and a fold the filling makes is repaired with
     // the others. Kinect frames kept a quarter of their loops without this
@@ -184,7 +160,7 @@ std::size_t fillLoops(const std::vector<Triangle> &triangles,
     bool duplicates_existing = false;
     for (Triangle t : filling) {
       std::sort(t.begin(), t.end());
-      duplicates_existing |= existing.count(t) > 0;
+      duplicates_existing |= std::binary_search(existing.begin(), existing.end(), t);
     }
     if (filling.empty() || duplicates_existing)
       continue;
@@ -197,6 +173,30 @@ std::size_t fillLoops(const std::vector<Triangle> &triangles,
     ++filled;
   }
   return filled;
+}
+
+std::size_t fillLoops(const std::vector<Triangle> &triangles,
+                      std::vector<std::vector<VertexIndex>> loops,
+                      const std::vector<Eigen::Vector3d> &points, int max_edges,
+                      const SideLimit &limit, const std::vector<bool> *only_around,
+                      std::vector<Triangle> &added) {
+  std::function<bool(VertexIndex)> around;
+  if (only_around)
+    around = [only_around](VertexIndex v) { return bool((*only_around)[v]); };
+  loops = fillableLoops(std::move(loops), max_edges, around);
+  if (loops.empty())
+    return 0;
+  // Existing edges and triangles matter only where all their corners are
+  // on a loop that may be filled: that keeps these lists short.
+  std::vector<bool> on_loop(points.size(), false);
+  for (const auto &loop : loops)
+    for (VertexIndex v : loop)
+      on_loop[v] = true;
+  std::vector<EdgeKey> mesh_edges;
+  std::vector<Triangle> existing;
+  edgesAndTrianglesAmong(
+      triangles, [&](VertexIndex v) { return bool(on_loop[v]); }, mesh_edges, existing);
+  return fillChosenLoops(loops, points, limit, std::move(mesh_edges), existing, added);
 }
 
 } // namespace detail

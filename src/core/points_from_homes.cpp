@@ -3,22 +3,12 @@
 // "Finishing in parts").
 #include "points_from_homes.h"
 
-#include "process_bytes.h"
-
 #include <algorithm>
 #include <array>
 #include <stdexcept>
 
 namespace pcl_ms {
 namespace detail {
-namespace {
-
-struct PointRequest {
-  std::uint64_t vertex;
-  std::uint32_t asker;
-};
-
-} // namespace
 
 const Eigen::Vector3d &CornerPoints::of(VertexIndex v) const {
   return points[static_cast<std::size_t>(std::lower_bound(vertices.begin(), vertices.end(), v) -
@@ -28,7 +18,6 @@ const Eigen::Vector3d &CornerPoints::of(VertexIndex v) const {
 CornerPoints cornerPointsFromHomes(const std::vector<Triangle> &mine,
                                    const std::vector<Eigen::Vector3d> &home,
                                    std::uint64_t home_first, ProcessGroup &group) {
-  const auto processes = static_cast<std::size_t>(group.processes());
   const std::vector<std::uint64_t> firsts =
       runFirsts(home.size(), home_first, group, "cornerPointsFromHomes (points)");
   const std::uint64_t point_count = firsts.back();
@@ -44,22 +33,15 @@ CornerPoints cornerPointsFromHomes(const std::vector<Triangle> &mine,
   if (totalOver(beyond ? 1 : 0, group) > 0)
     throw std::invalid_argument("cornerPointsFromHomes: a triangle has a corner beyond the points");
 
-  const auto homeOf = [&](std::uint64_t vertex) { return runHolding(firsts, vertex); };
-  std::vector<std::vector<PointRequest>> requests_out(processes);
-  for (VertexIndex v : corners.vertices)
-    requests_out[homeOf(v)].push_back({v, static_cast<std::uint32_t>(group.process())});
-  // Each home answers its askers in the order they asked; the homes hold
-  // ascending ranges and answers arrive in process order, so the points
-  // come back in the order of `vertices`.
-  std::vector<std::vector<std::array<double, 3>>> answers_out(processes);
-  deliver(requests_out, group, [&](const PointRequest &request) {
-    const Eigen::Vector3d &point = home[static_cast<std::size_t>(request.vertex - home_first)];
-    answers_out[request.asker].push_back({point.x(), point.y(), point.z()});
-  });
-  corners.points.reserve(corners.vertices.size());
-  deliver(answers_out, group, [&](const std::array<double, 3> &point) {
+  const std::vector<std::array<double, 3>> points = valuesFromHomes<std::array<double, 3>>(
+      corners.vertices, firsts, home_first,
+      [&](std::size_t i) {
+        return std::array<double, 3>{home[i].x(), home[i].y(), home[i].z()};
+      },
+      group);
+  corners.points.reserve(points.size());
+  for (const std::array<double, 3> &point : points)
     corners.points.emplace_back(point[0], point[1], point[2]);
-  });
   return corners;
 }
 

@@ -5,6 +5,8 @@
 // process order. Internal to the library: not installed.
 #pragma once
 
+#include "process_bytes.h"
+
 #include <pcl_ms/process_group.h>
 #include <pcl_ms/types.h>
 
@@ -24,6 +26,38 @@ struct CornerPoints {
   /// The position of corner v (one of `vertices`).
   const Eigen::Vector3d &of(VertexIndex v) const;
 };
+
+/// A request for point `vertex`'s values from the process `asker`.
+struct HomeRequest {
+  std::uint64_t vertex;
+  std::uint32_t asker;
+};
+
+/// Collective. Each process's values for `vertices` (ascending, each once,
+/// all below firsts.back()) from the processes holding them: `firsts` is
+/// runFirsts() of the home slices, this process's from `home_first` on,
+/// and make(i) gives the value (trivially copyable) of its home item i.
+template <typename Value, typename Make>
+std::vector<Value>
+valuesFromHomes(const std::vector<VertexIndex> &vertices, const std::vector<std::uint64_t> &firsts,
+                std::uint64_t home_first, const Make &make, ProcessGroup &group) {
+  const auto processes = static_cast<std::size_t>(group.processes());
+  std::vector<std::vector<HomeRequest>> requests_out(processes);
+  for (VertexIndex v : vertices)
+    requests_out[runHolding(firsts, v)].push_back({v, static_cast<std::uint32_t>(group.process())});
+  // Each home answers its askers in the order they asked; the homes hold
+  // ascending ranges and answers arrive in process order, so the values
+  // come back in the order of `vertices`.
+  std::vector<std::vector<Value>> answers_out(processes);
+  deliver(requests_out, group, [&](const HomeRequest &request) {
+    answers_out[request.asker].push_back(
+        make(static_cast<std::size_t>(request.vertex - home_first)));
+  });
+  std::vector<Value> values;
+  values.reserve(vertices.size());
+  deliver(answers_out, group, [&](const Value &value) { values.push_back(value); });
+  return values;
+}
 
 /// Collective. `home` holds the points from number `home_first` on. Every
 /// process asks the homes of its triangles' corners for them, one request
