@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <functional>
 
 namespace pcl_ms {
 namespace detail {
@@ -75,6 +76,30 @@ std::vector<std::vector<std::uint32_t>> fansAt(VertexIndex v,
 
 } // namespace
 
+void dropBowTieFans(VertexIndex v, const std::vector<std::uint32_t> &around,
+                    const std::vector<Triangle> &triangles,
+                    const std::function<bool(std::uint32_t)> &is_fixed,
+                    std::vector<std::uint32_t> &drop) {
+  if (around.size() < 2)
+    return;
+  const auto fans = fansAt(v, around, triangles);
+  if (fans.size() < 2)
+    return;
+  const std::size_t keep = fanToKeep(fans.size(), [&](std::size_t f) {
+    FanWeight weight;
+    if (is_fixed)
+      weight.fixed =
+          static_cast<std::size_t>(std::count_if(fans[f].begin(), fans[f].end(), is_fixed));
+    weight.size = fans[f].size();
+    return weight;
+  });
+  for (std::size_t f = 0; f < fans.size(); ++f)
+    if (f != keep)
+      for (std::uint32_t t : fans[f])
+        if (!is_fixed || !is_fixed(t))
+          drop.push_back(t);
+}
+
 void dropTriangles(std::vector<Triangle> &triangles, const std::vector<bool> &drop,
                    std::vector<bool> &touched, MeshEdges *edges) {
   const bool scan_again = edges && !dropFromMeshEdges(*edges, triangles, drop);
@@ -97,13 +122,13 @@ std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_co
                          std::vector<bool> &touched, const std::vector<Triangle> *fixed,
                          MeshEdges *edges) {
   const std::size_t before = triangles.size();
-  const auto isFixed = [&](std::uint32_t t) {
-    if (!fixed)
-      return false;
-    Triangle corners = triangles[t];
-    std::sort(corners.begin(), corners.end());
-    return std::binary_search(fixed->begin(), fixed->end(), corners);
-  };
+  std::function<bool(std::uint32_t)> isFixed;
+  if (fixed)
+    isFixed = [&](std::uint32_t t) {
+      Triangle corners = triangles[t];
+      std::sort(corners.begin(), corners.end());
+      return std::binary_search(fixed->begin(), fixed->end(), corners);
+    };
   touched.resize(vertex_count, false);
   // After the first round only the corners of what it removed can have
   // gained a second fan: the other vertices kept their triangles. The
@@ -117,26 +142,8 @@ std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_co
     changed = false;
     const MarkedIncidence incidence(triangles, check, removed);
     std::vector<std::uint32_t> drop;
-    for (std::size_t slot = 0; slot < incidence.vertices().size(); ++slot) {
-      const VertexIndex v = incidence.vertices()[slot];
-      if (incidence.atSlot(slot).size() < 2)
-        continue;
-      const auto fans = fansAt(v, incidence.atSlot(slot), triangles);
-      if (fans.size() < 2)
-        continue;
-      const std::size_t keep = fanToKeep(fans.size(), [&](std::size_t f) {
-        FanWeight weight;
-        weight.fixed =
-            static_cast<std::size_t>(std::count_if(fans[f].begin(), fans[f].end(), isFixed));
-        weight.size = fans[f].size();
-        return weight;
-      });
-      for (std::size_t f = 0; f < fans.size(); ++f)
-        if (f != keep)
-          for (std::uint32_t t : fans[f])
-            if (!isFixed(t))
-              drop.push_back(t);
-    }
+    for (std::size_t slot = 0; slot < incidence.vertices().size(); ++slot)
+      dropBowTieFans(incidence.vertices()[slot], incidence.atSlot(slot), triangles, isFixed, drop);
     if (!drop.empty()) {
       changed = any_removed = true;
       std::fill(check.begin(), check.end(), false);

@@ -193,6 +193,15 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
 void dropTriangles(std::vector<Triangle> &triangles, const std::vector<bool> &drop,
                    std::vector<bool> &touched, MeshEdges *edges = nullptr);
 
+/// One vertex's share of a round of splitBowTies(): the triangles `around`
+/// v (ascending; numbers into `triangles`) grouped into fans joined by
+/// edges at v, and those of every fan but the one to keep (fan_choice.h)
+/// appended to `drop`, except those is_fixed (if given) marks.
+void dropBowTieFans(VertexIndex v, const std::vector<std::uint32_t> &around,
+                    const std::vector<Triangle> &triangles,
+                    const std::function<bool(std::uint32_t)> &is_fixed,
+                    std::vector<std::uint32_t> &drop);
+
 /// splitBowTies() keeping `edges` (with neighbours) up to date.
 std::size_t splitBowTies(std::vector<Triangle> &triangles, std::size_t vertex_count,
                          std::vector<bool> &touched, const std::vector<Triangle> *fixed,
