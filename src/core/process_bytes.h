@@ -57,6 +57,15 @@ inline std::uint64_t maximumOver(std::uint64_t mine, ProcessGroup &group) {
   return static_cast<std::uint64_t>(largest[0]);
 }
 
+/// Where each run starts, then the list's length, from the runs' counts
+/// (countsOf): runFirsts() for runs known to follow each other.
+inline std::vector<std::uint64_t> firstsOf(const std::vector<std::uint64_t> &counts) {
+  std::vector<std::uint64_t> firsts(counts.size() + 1, 0);
+  for (std::size_t p = 0; p < counts.size(); ++p)
+    firsts[p + 1] = firsts[p] + counts[p];
+  return firsts;
+}
+
 /// Where each process's run of a list held in parts starts (this process's
 /// run: `count` items from number `first` on), on every process, then the
 /// whole list's length. Checked on the gathered figures, so that every
@@ -64,14 +73,10 @@ inline std::uint64_t maximumOver(std::uint64_t mine, ProcessGroup &group) {
 /// do not follow each other from item 0 in process order.
 inline std::vector<std::uint64_t> runFirsts(std::uint64_t count, std::uint64_t first,
                                             ProcessGroup &group, const std::string &what) {
-  const std::vector<std::uint64_t> counts = countsOf(count, group);
-  std::vector<std::uint64_t> firsts(counts.size() + 1);
+  const std::vector<std::uint64_t> firsts = firstsOf(countsOf(count, group));
   const std::vector<unsigned char> gathered = group.gatherAll(bytesOf(&first, 1));
-  std::memcpy(firsts.data(), gathered.data(), counts.size() * sizeof(std::uint64_t));
-  for (std::size_t p = 0; p < counts.size(); ++p)
-    if (firsts[p] != (p == 0 ? 0 : firsts[p - 1] + counts[p - 1]))
-      throw std::invalid_argument(what + ": the processes' runs do not follow each other from 0");
-  firsts.back() = firsts[counts.size() - 1] + counts.back();
+  if (std::memcmp(gathered.data(), firsts.data(), gathered.size()) != 0)
+    throw std::invalid_argument(what + ": the processes' runs do not follow each other from 0");
   return firsts;
 }
 
