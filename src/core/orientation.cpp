@@ -17,21 +17,6 @@ namespace pcl_ms {
 namespace detail {
 namespace {
 
-// An inconsistent edge that bends by more than this (90 degrees) is a fold,
-// cut whatever its twist: a crumpled spot, never the gentle twist of a real
-// Moebius band, which is kept and reported.
-constexpr double max_untwist_bending = M_PI / 2;
-// A twist that an orientation-reversing walk of at most this many triangles
-// closes is a crumple: the two triangles of its inconsistent edge are cut out
-// and the hole refilled.
-constexpr int max_local_twist_steps = 32;
-// Or a walk of at most this many times the square root of the component's
-// triangle count: a component's diameter in triangles is about that root.
-// A real Moebius band reverses only all the way round, which is several
-// times its root (10,000-point sampling: 823 steps, root 140); the longest
-// twists left in PCL's scans closed within 109 steps (car6, root 118).
-constexpr double max_twist_steps_per_root = 2.0;
-
 /// Calls measure(p, q, t's apex, u's apex) for the edge pq (p the lower
 /// vertex) that t and u share.
 template <typename Measure>
@@ -404,13 +389,8 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
     // with 1,108 loops; this rule, 291 and 691.
     auto moreEdgeOn = [&](std::uint32_t t, std::uint32_t u) {
       auto facing = [&](std::uint32_t triangle) {
-        const Eigen::Vector3d &a = points[triangles[triangle][0]],
-                              &b = points[triangles[triangle][1]],
-                              &c = points[triangles[triangle][2]];
-        const Eigen::Vector3d normal = (b - a).cross(c - a);
-        const Eigen::Vector3d to_viewpoint = *viewpoint - (a + b + c) / 3;
-        const double lengths = normal.norm() * to_viewpoint.norm();
-        return lengths > 0 ? std::abs(normal.dot(to_viewpoint)) / lengths : 0.0;
+        return facingOf(points[triangles[triangle][0]], points[triangles[triangle][1]],
+                        points[triangles[triangle][2]], *viewpoint);
       };
       return facing(t) < facing(u) ? t : u;
     };
@@ -419,8 +399,7 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
     for (const Conflict &conflict : conflicts) {
       const std::uint32_t t = conflict.t, u = conflict.u;
       const std::uint32_t component = triangle_component[t];
-      const int long_walk = static_cast<int>(
-          max_twist_steps_per_root * std::sqrt(static_cast<double>(component_size[component])));
+      const int long_walk = longTwistSteps(component_size[component]);
       auto localTwist = [&]() {
         if (walk.reversesWithin(t, max_local_twist_steps, triangles, neighbours))
           return true;
