@@ -107,15 +107,7 @@ CutPart cutInParts(const std::vector<Triangle> &mine, std::uint64_t first,
     all_check.erase(std::unique(all_check.begin(), all_check.end()), all_check.end());
     if (totalOver(all_check.size(), group) == 0)
       break;
-    {
-      std::vector<std::vector<VertexIndex>> check_out(processes);
-      for (std::size_t p = 1; p < processes && group.process() == 0; ++p)
-        check_out[p] = all_check;
-      std::vector<VertexIndex> received;
-      deliver(check_out, group, [&](VertexIndex v) { received.push_back(v); });
-      if (group.process() != 0)
-        all_check = std::move(received);
-    }
+    fromZeroToAll(all_check, group);
     std::vector<std::vector<AtVertex>> at_out(processes);
     for (std::size_t t = 0; t < left.size(); ++t)
       if (!split_off[t])

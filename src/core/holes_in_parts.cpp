@@ -98,16 +98,7 @@ HolesPart fillHolesInParts(const std::vector<Triangle> &mine, const MeshEdgesPar
     part.filled = 0;
     return part;
   }
-  {
-    std::vector<std::vector<VertexIndex>> vertices_out(processes);
-    if (on_zero)
-      for (std::size_t p = 1; p < processes; ++p)
-        vertices_out[p] = on_loops;
-    std::vector<VertexIndex> received;
-    deliver(vertices_out, group, [&](VertexIndex v) { received.push_back(v); });
-    if (!on_zero)
-      on_loops = std::move(received);
-  }
+  fromZeroToAll(on_loops, group);
 
   // To process 0: the edges and triangles among those vertices, and the
   // vertices' points and scales (numbered by their place in on_loops: the

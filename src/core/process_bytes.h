@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace pcl_ms {
@@ -105,6 +106,17 @@ void deliver(std::vector<std::vector<Value>> &outgoing, ProcessGroup &group, con
     std::memcpy(&value, received.data() + at, sizeof value);
     take(value);
   }
+}
+
+/// Every process gets process 0's `values` (the others' are replaced).
+template <typename Value> void fromZeroToAll(std::vector<Value> &values, ProcessGroup &group) {
+  std::vector<std::vector<Value>> outgoing(static_cast<std::size_t>(group.processes()));
+  for (std::size_t p = 1; p < outgoing.size() && group.process() == 0; ++p)
+    outgoing[p] = values;
+  std::vector<Value> received;
+  deliver(outgoing, group, [&](const Value &value) { received.push_back(value); });
+  if (group.process() != 0)
+    values = std::move(received);
 }
 
 /// Process 0 gets every process's `count` values (make(i) gives value i):
