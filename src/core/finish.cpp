@@ -360,10 +360,6 @@ std::vector<std::vector<VertexIndex>> boundaryLoops(const std::vector<EdgeKey> &
 
 namespace {
 
-// Twists are cut and the opened loops refilled at most this many times.
-constexpr int max_untwist_rounds = 3;
-// Loops opened by cutting twists are closed again up to this size.
-constexpr int max_untwist_loop_edges = 16;
 // Room kept for hole fillings: a 1M-point surface (2M triangles) takes
 // about 500 triangles in 100 holes.
 constexpr std::size_t fill_room_divisor = 256;
@@ -425,7 +421,7 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
                                          viewpoint);
   };
   std::vector<std::uint32_t> to_cut = fillThenOrient(fill_holes_max_edges, nullptr);
-  for (int round = 0; round < max_untwist_rounds && !to_cut.empty(); ++round) {
+  for (int round = 0; round < detail::max_untwist_rounds && !to_cut.empty(); ++round) {
     // Only the triangles at the inconsistent edges go, never whole fans:
     // cutting the most crumpled corner's fan at sharp folds split sparse
     // scans and the camel head apart (car6: 80 pieces instead of 52).
@@ -440,7 +436,7 @@ FinishedSurface finishSurface(std::vector<Triangle> triangles,
                          &edges);
     surface.twist_triangles_removed += before - triangles.size();
     // The loops that removal opened are ours to close, whatever the user's limit.
-    to_cut = fillThenOrient(max_untwist_loop_edges, &touched);
+    to_cut = fillThenOrient(detail::max_untwist_loop_edges, &touched);
   }
   surface.triangles = std::move(triangles);
   return surface;

@@ -102,6 +102,11 @@ struct MeshEdges {
   bool crowded = false;
 };
 
+// Twists are cut and the opened loops refilled at most this many times.
+inline constexpr int max_untwist_rounds = 3;
+// Loops opened by cutting twists are closed again up to this size.
+inline constexpr int max_untwist_loop_edges = 16;
+
 /// Scans every edge of `triangles` once. The (edge, triangle) incidences are
 /// sorted a block of lower vertices at a time, at most `block_uses` per
 /// block (16M: 128 MB), so that finishing a 20M-triangle surface never holds
