@@ -8,6 +8,7 @@
 #include "core_test_support.h"
 #include "edges_in_parts.h"
 #include "finish_steps.h"
+#include "parts_test_support.h"
 #include "points_from_homes.h"
 #include "thread_processes.h"
 #include "twists_in_parts.h"
@@ -124,20 +125,16 @@ TEST(ConflictsInParts, CutsAreThoseOfOneProcessForAnySplitWithOrWithoutAViewpoin
       std::vector<std::vector<std::uint64_t>> chosen(static_cast<std::size_t>(processes));
       pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
         const auto p = static_cast<std::size_t>(group.process());
-        const std::vector<Triangle> mine(triangles.begin() + static_cast<std::ptrdiff_t>(cuts[p]),
-                                         triangles.begin() +
-                                             static_cast<std::ptrdiff_t>(cuts[p + 1]));
+        const std::vector<Triangle> mine = pcl_ms_test::sliceOf(triangles, cuts[p], cuts[p + 1]);
         const std::size_t home_begin = points.size() * p / processes,
                           home_end = points.size() * (p + 1) / processes;
-        const std::vector<Eigen::Vector3d> home(
-            points.begin() + static_cast<std::ptrdiff_t>(home_begin),
-            points.begin() + static_cast<std::ptrdiff_t>(home_end));
-        const detail::MeshEdgesPart edges =
-            detail::meshEdgesInParts(mine, cuts[p], points.size(), group);
-        const detail::ComponentsPart components =
-            detail::componentsInParts(mine, cuts[p], edges, group);
-        const detail::CornerPoints corners =
-            detail::cornerPointsFromHomes(mine, home, home_begin, group);
+        const std::vector<Eigen::Vector3d> home =
+            pcl_ms_test::sliceOf(points, home_begin, home_end);
+        const pcl_ms_test::OrientationInputs inputs =
+            pcl_ms_test::orientationInputs(mine, cuts[p], home, home_begin, points.size(), group);
+        const detail::MeshEdgesPart &edges = inputs.edges;
+        const detail::ComponentsPart &components = inputs.components;
+        const detail::CornerPoints &corners = inputs.corners;
         const detail::TwistsPart twists =
             detail::twistForestInParts(mine, cuts[p], edges, components, corners, group);
         std::vector<Triangle> turned = mine;

@@ -6,6 +6,7 @@
 #include "core_test_support.h"
 #include "cuts_in_parts.h"
 #include "finish_steps.h"
+#include "parts_test_support.h"
 #include "thread_processes.h"
 
 #include <gtest/gtest.h>
@@ -49,9 +50,7 @@ TEST(CutsInParts, KeptTrianglesAndTouchedVerticesAreThoseOfOneProcessForAnySplit
     std::vector<detail::CutPart> parts(static_cast<std::size_t>(processes));
     pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
       const auto p = static_cast<std::size_t>(group.process());
-      const std::vector<Triangle> mine(triangles.begin() + static_cast<std::ptrdiff_t>(cuts[p]),
-                                       triangles.begin() +
-                                           static_cast<std::ptrdiff_t>(cuts[p + 1]));
+      const std::vector<Triangle> mine = pcl_ms_test::sliceOf(triangles, cuts[p], cuts[p + 1]);
       // The numbers to cut given round-robin, mostly not on their holders.
       std::vector<std::uint64_t> mine_to_cut;
       for (std::size_t i = p; i < to_cut.size(); i += static_cast<std::size_t>(processes))

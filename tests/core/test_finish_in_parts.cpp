@@ -5,13 +5,13 @@
 // in for processes.
 #include "core_test_support.h"
 #include "finish_in_parts.h"
+#include "parts_test_support.h"
 #include "thread_processes.h"
 
 #include <gtest/gtest.h>
 #include <pcl_ms/finish.h>
 
 #include <algorithm>
-#include <cmath>
 #include <random>
 #include <string>
 #include <vector>
@@ -63,9 +63,7 @@ TEST(FinishInParts, TheSurfaceIsOneProcesssForAnySplitWithOrWithoutAViewpoint) {
   std::vector<Triangle> triangles;
   const std::vector<Eigen::Vector3d> points = crumpledSurface(triangles);
   const std::size_t n = triangles.size(), point_count = points.size();
-  std::vector<float> scales(point_count);
-  for (std::size_t v = 0; v < point_count; ++v)
-    scales[v] = static_cast<float>(0.0012 * (1.5 + std::sin(0.37 * static_cast<double>(v))));
+  const std::vector<float> scales = pcl_ms_test::varyingScales(point_count);
   constexpr int max_edges = 12;
   constexpr double rho = 5;
   const Eigen::Vector3d viewpoint(0.3, 0.4, 1.5);
@@ -93,17 +91,12 @@ TEST(FinishInParts, TheSurfaceIsOneProcesssForAnySplitWithOrWithoutAViewpoint) {
       std::vector<detail::FinishedPart> parts(static_cast<std::size_t>(processes));
       pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
         const auto p = static_cast<std::size_t>(group.process());
-        const std::vector<Triangle> mine(triangles.begin() + static_cast<std::ptrdiff_t>(cuts[p]),
-                                         triangles.begin() +
-                                             static_cast<std::ptrdiff_t>(cuts[p + 1]));
-        const std::size_t home_begin = point_count * p * p / (processes * processes),
-                          home_end = point_count * (p + 1) * (p + 1) / (processes * processes);
-        const std::vector<Eigen::Vector3d> home(
-            points.begin() + static_cast<std::ptrdiff_t>(home_begin),
-            points.begin() + static_cast<std::ptrdiff_t>(home_end));
-        const std::vector<float> home_scales(
-            scales.begin() + static_cast<std::ptrdiff_t>(home_begin),
-            scales.begin() + static_cast<std::ptrdiff_t>(home_end));
+        const std::vector<Triangle> mine = pcl_ms_test::sliceOf(triangles, cuts[p], cuts[p + 1]);
+        const std::size_t home_begin = pcl_ms_test::unevenCut(point_count, p, processes),
+                          home_end = pcl_ms_test::unevenCut(point_count, p + 1, processes);
+        const std::vector<Eigen::Vector3d> home =
+            pcl_ms_test::sliceOf(points, home_begin, home_end);
+        const std::vector<float> home_scales = pcl_ms_test::sliceOf(scales, home_begin, home_end);
         parts[p] = detail::finishInParts(mine, cuts[p], home, home_scales, home_begin, max_edges,
                                          rho, view, group);
       });

@@ -9,6 +9,7 @@
 #include "edges_in_parts.h"
 #include "exact_signs.h"
 #include "finish_steps.h"
+#include "parts_test_support.h"
 #include "points_from_homes.h"
 #include "sides_in_parts.h"
 #include "thread_processes.h"
@@ -36,12 +37,7 @@ namespace {
 /// taken out): boundary edges along its cut and round the holes, manifold
 /// edges elsewhere.
 std::vector<Triangle> holedBunnyPatch() {
-  const std::vector<Triangle> &all = pcl_ms_test::bunnyReference().triangles;
-  std::vector<Triangle> holed;
-  for (std::size_t t = 0; t < 20000; ++t)
-    if (t % 31 != 0)
-      holed.push_back(all[t]);
-  return holed;
+  return pcl_ms_test::bunnyPatchWithout([](std::size_t t) { return t % 31 == 0; });
 }
 
 std::uint64_t vertexCount() { return pcl_ms_test::bunnyReference().vertices.size(); }
@@ -69,8 +65,7 @@ void expectSharesOfTheWholeScan(const std::vector<Triangle> &triangles,
   std::vector<detail::MeshEdgesPart> parts(static_cast<std::size_t>(processes));
   pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
     const auto p = static_cast<std::size_t>(group.process());
-    const std::vector<Triangle> mine(triangles.begin() + static_cast<std::ptrdiff_t>(cuts[p]),
-                                     triangles.begin() + static_cast<std::ptrdiff_t>(cuts[p + 1]));
+    const std::vector<Triangle> mine = pcl_ms_test::sliceOf(triangles, cuts[p], cuts[p + 1]);
     parts[p] = detail::meshEdgesInParts(mine, cuts[p], vertexCount(), group);
   });
   std::vector<std::pair<detail::EdgeKey, std::uint64_t>> boundary_of_parts;
@@ -235,9 +230,7 @@ TEST(ComponentsInParts, ComponentsTurnsAndOrientabilityAreThoseOfOneProcessForAn
     std::vector<detail::ComponentsPart> parts(static_cast<std::size_t>(processes));
     pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
       const auto p = static_cast<std::size_t>(group.process());
-      const std::vector<Triangle> mine(triangles.begin() + static_cast<std::ptrdiff_t>(cuts[p]),
-                                       triangles.begin() +
-                                           static_cast<std::ptrdiff_t>(cuts[p + 1]));
+      const std::vector<Triangle> mine = pcl_ms_test::sliceOf(triangles, cuts[p], cuts[p + 1]);
       const detail::MeshEdgesPart edges =
           detail::meshEdgesInParts(mine, cuts[p], points.size(), group);
       parts[p] = detail::componentsInParts(mine, cuts[p], edges, group);
@@ -391,21 +384,17 @@ TEST(SidesInParts, TurnsAreThoseOfOneProcessForAnySplitWithOrWithoutAViewpoint) 
       std::vector<std::vector<std::uint8_t>> turned(static_cast<std::size_t>(processes));
       pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
         const auto p = static_cast<std::size_t>(group.process());
-        const std::vector<Triangle> mine(triangles.begin() + static_cast<std::ptrdiff_t>(cuts[p]),
-                                         triangles.begin() +
-                                             static_cast<std::ptrdiff_t>(cuts[p + 1]));
+        const std::vector<Triangle> mine = pcl_ms_test::sliceOf(triangles, cuts[p], cuts[p + 1]);
         // Home slices cut elsewhere than the runs, the first one empty.
-        const std::size_t home_begin = point_count * p * p / (processes * processes),
-                          home_end = point_count * (p + 1) * (p + 1) / (processes * processes);
-        const std::vector<Eigen::Vector3d> home(
-            points.begin() + static_cast<std::ptrdiff_t>(home_begin),
-            points.begin() + static_cast<std::ptrdiff_t>(home_end));
-        const detail::MeshEdgesPart edges =
-            detail::meshEdgesInParts(mine, cuts[p], point_count, group);
-        const detail::ComponentsPart components =
-            detail::componentsInParts(mine, cuts[p], edges, group);
-        const detail::CornerPoints corners =
-            detail::cornerPointsFromHomes(mine, home, home_begin, group);
+        const std::size_t home_begin = pcl_ms_test::unevenCut(point_count, p, processes),
+                          home_end = pcl_ms_test::unevenCut(point_count, p + 1, processes);
+        const std::vector<Eigen::Vector3d> home =
+            pcl_ms_test::sliceOf(points, home_begin, home_end);
+        const pcl_ms_test::OrientationInputs inputs =
+            pcl_ms_test::orientationInputs(mine, cuts[p], home, home_begin, point_count, group);
+        const detail::MeshEdgesPart &edges = inputs.edges;
+        const detail::ComponentsPart &components = inputs.components;
+        const detail::CornerPoints &corners = inputs.corners;
         turned[p] =
             detail::sideTurnsInParts(mine, cuts[p], edges, components, corners, viewpoint, group);
       });
@@ -559,21 +548,17 @@ TEST(TwistsInParts, ForestTurnsAndConflictsAreThoseOfOneProcessForAnySplit) {
       std::vector<detail::TwistsPart> parts(static_cast<std::size_t>(processes));
       pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
         const auto p = static_cast<std::size_t>(group.process());
-        const std::vector<Triangle> mine(triangles.begin() + static_cast<std::ptrdiff_t>(cuts[p]),
-                                         triangles.begin() +
-                                             static_cast<std::ptrdiff_t>(cuts[p + 1]));
+        const std::vector<Triangle> mine = pcl_ms_test::sliceOf(triangles, cuts[p], cuts[p + 1]);
         // Home slices cut evenly, elsewhere than the runs.
         const std::size_t home_begin = points.size() * p / processes,
                           home_end = points.size() * (p + 1) / processes;
-        const std::vector<Eigen::Vector3d> home(
-            points.begin() + static_cast<std::ptrdiff_t>(home_begin),
-            points.begin() + static_cast<std::ptrdiff_t>(home_end));
-        const detail::MeshEdgesPart edges =
-            detail::meshEdgesInParts(mine, cuts[p], points.size(), group);
-        const detail::ComponentsPart components =
-            detail::componentsInParts(mine, cuts[p], edges, group);
-        const detail::CornerPoints corners =
-            detail::cornerPointsFromHomes(mine, home, home_begin, group);
+        const std::vector<Eigen::Vector3d> home =
+            pcl_ms_test::sliceOf(points, home_begin, home_end);
+        const pcl_ms_test::OrientationInputs inputs =
+            pcl_ms_test::orientationInputs(mine, cuts[p], home, home_begin, points.size(), group);
+        const detail::MeshEdgesPart &edges = inputs.edges;
+        const detail::ComponentsPart &components = inputs.components;
+        const detail::CornerPoints &corners = inputs.corners;
         parts[p] = detail::twistForestInParts(mine, cuts[p], edges, components, corners, group);
       });
       std::vector<detail::TwistConflict> conflicts;

@@ -6,12 +6,12 @@
 #include "edges_in_parts.h"
 #include "finish_steps.h"
 #include "holes_in_parts.h"
+#include "parts_test_support.h"
 #include "thread_processes.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -24,21 +24,7 @@ namespace {
 /// triangles (every 31st taken out, and runs of three every 97), which
 /// fill or not by their size and shape, beside the patch's long cut.
 std::vector<Triangle> bunnyPatchWithHoles() {
-  const std::vector<Triangle> &all = pcl_ms_test::bunnyReference().triangles;
-  std::vector<Triangle> holed;
-  for (std::size_t t = 0; t < 20000; ++t)
-    if (t % 31 != 0 && t % 97 >= 3)
-      holed.push_back(all[t]);
-  return holed;
-}
-
-/// Local scales that vary from point to point, so that the size limit
-/// refuses some fillings.
-std::vector<float> varyingScales(std::size_t count) {
-  std::vector<float> scales(count);
-  for (std::size_t v = 0; v < count; ++v)
-    scales[v] = static_cast<float>(0.0012 * (1.5 + std::sin(0.37 * static_cast<double>(v))));
-  return scales;
+  return pcl_ms_test::bunnyPatchWithout([](std::size_t t) { return t % 31 == 0 || t % 97 < 3; });
 }
 
 struct FilledInOneProcess {
@@ -68,7 +54,7 @@ FilledInOneProcess fillInOneProcess(std::vector<Triangle> triangles,
 TEST(HolesInParts, FillingsAndLoopsAreThoseOfOneProcessForAnySplit) {
   const std::vector<Triangle> triangles = bunnyPatchWithHoles();
   const std::vector<Eigen::Vector3d> &points = pcl_ms_test::bunnyReference().vertices;
-  const std::vector<float> scales = varyingScales(points.size());
+  const std::vector<float> scales = pcl_ms_test::varyingScales(points.size());
   const std::size_t n = triangles.size(), point_count = points.size();
   constexpr int max_edges = 12;
   constexpr double rho = 5;
@@ -97,18 +83,13 @@ TEST(HolesInParts, FillingsAndLoopsAreThoseOfOneProcessForAnySplit) {
       std::vector<detail::HolesPart> parts(static_cast<std::size_t>(processes));
       pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
         const auto p = static_cast<std::size_t>(group.process());
-        const std::vector<Triangle> mine(triangles.begin() + static_cast<std::ptrdiff_t>(cuts[p]),
-                                         triangles.begin() +
-                                             static_cast<std::ptrdiff_t>(cuts[p + 1]));
+        const std::vector<Triangle> mine = pcl_ms_test::sliceOf(triangles, cuts[p], cuts[p + 1]);
         // Home slices cut elsewhere than the runs, the first one empty.
-        const std::size_t home_begin = point_count * p * p / (processes * processes),
-                          home_end = point_count * (p + 1) * (p + 1) / (processes * processes);
-        const std::vector<Eigen::Vector3d> home(
-            points.begin() + static_cast<std::ptrdiff_t>(home_begin),
-            points.begin() + static_cast<std::ptrdiff_t>(home_end));
-        const std::vector<float> home_scales(
-            scales.begin() + static_cast<std::ptrdiff_t>(home_begin),
-            scales.begin() + static_cast<std::ptrdiff_t>(home_end));
+        const std::size_t home_begin = pcl_ms_test::unevenCut(point_count, p, processes),
+                          home_end = pcl_ms_test::unevenCut(point_count, p + 1, processes);
+        const std::vector<Eigen::Vector3d> home =
+            pcl_ms_test::sliceOf(points, home_begin, home_end);
+        const std::vector<float> home_scales = pcl_ms_test::sliceOf(scales, home_begin, home_end);
         // The processes before the last mark a share of the vertices each;
         // the last (of several) gives no list.
         const std::size_t listing = processes > 1 ? static_cast<std::size_t>(processes) - 1 : 1;
@@ -142,7 +123,7 @@ TEST(HolesInParts, FillingsAndLoopsAreThoseOfOneProcessForAnySplit) {
 TEST(HolesInParts, NothingToFillLeavesTheLoopsAsTraced) {
   const std::vector<Triangle> triangles = bunnyPatchWithHoles();
   const std::vector<Eigen::Vector3d> &points = pcl_ms_test::bunnyReference().vertices;
-  const std::vector<float> scales = varyingScales(points.size());
+  const std::vector<float> scales = pcl_ms_test::varyingScales(points.size());
   const std::size_t n = triangles.size();
   const std::vector<std::vector<VertexIndex>> traced =
       detail::boundaryLoops(detail::meshEdges(triangles, false).boundary);
@@ -176,7 +157,7 @@ TEST(HolesInParts, NothingToFillLeavesTheLoopsAsTraced) {
 TEST(HolesInParts, SlicesThatDoNotFollowEachOtherOrLackScalesFailOnEveryProcess) {
   const std::vector<Triangle> triangles = bunnyPatchWithHoles();
   const std::vector<Eigen::Vector3d> &points = pcl_ms_test::bunnyReference().vertices;
-  const std::vector<float> scales = varyingScales(points.size());
+  const std::vector<float> scales = pcl_ms_test::varyingScales(points.size());
   const std::size_t half = points.size() / 2;
   // Each case: where process 1's slice starts, and whether it lacks a scale.
   const std::vector<std::pair<std::size_t, bool>> cases = {
