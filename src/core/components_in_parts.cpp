@@ -79,7 +79,7 @@ std::vector<std::vector<PieceAnswer>> joinPieces(std::vector<CrossSide> &sides,
       continue;
     done = 1;
     const auto [root, flip] = forest.find(p);
-    answers[side.process].push_back({side.piece, numberOf.piece(root), flip,
+    answers[side.process].push_back({side.piece, numberOf.id(root), flip,
                                      static_cast<std::uint8_t>(!component_conflicted[root])});
   }
   return answers;

@@ -4,6 +4,7 @@
 #include "conflicts_in_parts.h"
 
 #include "finish_steps.h"
+#include "numbering.h"
 #include "process_bytes.h"
 #include "twist_bending.h"
 
@@ -176,30 +177,20 @@ conflictCutsInParts(const std::vector<Triangle> &turned, std::uint64_t first,
     const TriangleAnswer &u_side = *std::lower_bound(
         across.begin(), across.end(), conflict.u,
         [](const TriangleAnswer &answer, std::uint64_t u) { return answer.u < u; });
-    const auto pointOf = [&](VertexIndex v) -> Eigen::Vector3d {
-      for (int k = 0; k < 3; ++k)
-        if (u_side.corners[k] == v)
-          return {u_side.points[3 * k], u_side.points[3 * k + 1], u_side.points[3 * k + 2]};
-      return corners.of(v);
+    const auto uPoint = [&](int k) -> Eigen::Vector3d {
+      return {u_side.points[3 * k], u_side.points[3 * k + 1], u_side.points[3 * k + 2]};
     };
     if (viewpoint) {
       const double t_facing = facingOf(corners.of(t_corners[0]), corners.of(t_corners[1]),
                                        corners.of(t_corners[2]), *viewpoint);
-      const double u_facing = facingOf(pointOf(u_side.corners[0]), pointOf(u_side.corners[1]),
-                                       pointOf(u_side.corners[2]), *viewpoint);
+      const double u_facing = facingOf(uPoint(0), uPoint(1), uPoint(2), *viewpoint);
       cuts.push_back(t_facing < u_facing ? conflict.t : conflict.u);
       continue;
     }
     const EdgeKey edge = sharedEdge(t_corners, u_side.corners);
-    const auto apexOf = [&](const Triangle &triangle) {
-      for (VertexIndex v : triangle)
-        if (v != lowVertex(edge) && v != highVertex(edge))
-          return v;
-      return lowVertex(edge);
-    };
     if (bendingAngle(corners.of(lowVertex(edge)), corners.of(highVertex(edge)),
-                     corners.of(apexOf(t_corners)),
-                     pointOf(apexOf(u_side.corners))) > max_untwist_bending) {
+                     corners.of(t_corners[apexCorner(t_corners, edge)]),
+                     uPoint(apexCorner(u_side.corners, edge))) > max_untwist_bending) {
       cuts.push_back(conflict.t);
       cuts.push_back(conflict.u);
       continue;
@@ -217,20 +208,15 @@ conflictCutsInParts(const std::vector<Triangle> &turned, std::uint64_t first,
       pending.size(), [&](std::size_t i) { return pending[i]; },
       [&](std::size_t, const Pending &one) { waiting.push_back(one); }, group);
   std::sort(waiting.begin(), waiting.end());
-  std::vector<std::uint64_t> twisted;
+  std::vector<std::uint64_t> waiting_components;
   for (const Pending &one : waiting)
-    twisted.push_back(one.component);
-  std::sort(twisted.begin(), twisted.end());
-  twisted.erase(std::unique(twisted.begin(), twisted.end()), twisted.end());
-  fromZeroToAll(twisted, group);
-  const auto twistedIndex = [&](std::uint64_t component) {
-    return static_cast<std::size_t>(std::lower_bound(twisted.begin(), twisted.end(), component) -
-                                    twisted.begin());
-  };
+    waiting_components.push_back(one.component);
+  fromZeroToAll(waiting_components, group);
+  const Numbering<std::uint64_t> twisted(std::move(waiting_components));
   std::vector<std::uint64_t> size(twisted.size(), 0);
   for (std::uint64_t component : components.component)
-    if (std::binary_search(twisted.begin(), twisted.end(), component))
-      ++size[twistedIndex(component)];
+    if (twisted.contains(component))
+      ++size[twisted(component)];
   group.sum(size);
 
   // Short walks for all at once.
@@ -255,7 +241,7 @@ conflictCutsInParts(const std::vector<Triangle> &turned, std::uint64_t first,
       for (std::size_t i = 0; i < waiting.size(); ++i) {
         if (verdict[i] != undecided)
           continue;
-        const std::size_t component = twistedIndex(waiting[i].component);
+        const std::size_t component = twisted(waiting[i].component);
         const int long_walk = longTwistSteps(size[component]);
         if (short_twist[i])
           verdict[i] = cut;
@@ -277,7 +263,7 @@ conflictCutsInParts(const std::vector<Triangle> &turned, std::uint64_t first,
       const std::size_t i = wave_conflict[k];
       verdict[i] = long_twist[k] ? cut : kept;
       if (!long_twist[k])
-        real_twist[twistedIndex(waiting[i].component)] = 1;
+        real_twist[twisted(waiting[i].component)] = 1;
     }
   }
   for (std::size_t i = 0; i < waiting.size(); ++i)

@@ -7,6 +7,7 @@
 #include "process_bytes.h"
 
 #include <algorithm>
+#include <iterator>
 #include <stdexcept>
 
 namespace pcl_ms {

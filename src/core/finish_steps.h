@@ -68,6 +68,14 @@ inline EdgeKey sharedEdge(const Triangle &first, const Triangle &second) {
   return edgeKey(shared[0], shared[1]);
 }
 
+/// The corner (0-2) of triangle t that is neither end of its edge `key`.
+inline int apexCorner(const Triangle &t, EdgeKey key) {
+  for (int k = 0; k < 3; ++k)
+    if (t[k] != lowVertex(key) && t[k] != highVertex(key))
+      return k;
+  return 0;
+}
+
 /// Whether triangle t, as stored, runs from a to b.
 inline bool runsFromTo(const Triangle &t, VertexIndex a, VertexIndex b) {
   for (int k = 0; k < 3; ++k)

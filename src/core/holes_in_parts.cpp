@@ -4,10 +4,12 @@
 #include "holes_in_parts.h"
 
 #include "finish_steps.h"
+#include "numbering.h"
 #include "points_from_homes.h"
 #include "process_bytes.h"
 
 #include <algorithm>
+#include <iterator>
 #include <stdexcept>
 #include <utility>
 
@@ -82,7 +84,7 @@ HolesPart fillHolesInParts(const std::vector<Triangle> &mine, const MeshEdgesPar
   // Process 0: the loops and those to fill; their vertices to everyone.
   HolesPart part;
   std::vector<std::vector<VertexIndex>> chosen;
-  std::vector<VertexIndex> on_loops;
+  std::vector<VertexIndex> loop_vertices;
   if (on_zero) {
     part.loops = boundaryLoops(boundary);
     std::function<bool(VertexIndex)> isMarked;
@@ -90,44 +92,35 @@ HolesPart fillHolesInParts(const std::vector<Triangle> &mine, const MeshEdgesPar
       isMarked = [&](VertexIndex v) { return std::binary_search(marked.begin(), marked.end(), v); };
     chosen = fillableLoops(part.loops, max_edges, isMarked);
     for (const std::vector<VertexIndex> &loop : chosen)
-      on_loops.insert(on_loops.end(), loop.begin(), loop.end());
-    std::sort(on_loops.begin(), on_loops.end());
-    on_loops.erase(std::unique(on_loops.begin(), on_loops.end()), on_loops.end());
+      loop_vertices.insert(loop_vertices.end(), loop.begin(), loop.end());
   }
-  if (totalOver(on_loops.size(), group) == 0) {
-    part.filled = 0;
+  if (totalOver(loop_vertices.size(), group) == 0)
     return part;
-  }
-  fromZeroToAll(on_loops, group);
+  fromZeroToAll(loop_vertices, group);
+  const Numbering<VertexIndex> on_loops(std::move(loop_vertices));
 
   // To process 0: the edges and triangles among those vertices, and the
-  // vertices' points and scales (numbered by their place in on_loops: the
-  // order of the numbers is kept, so every order and key the filling
-  // compares is one process's).
-  const auto localOf = [&](VertexIndex v) {
-    return static_cast<VertexIndex>(std::lower_bound(on_loops.begin(), on_loops.end(), v) -
-                                    on_loops.begin());
-  };
+  // vertices' points and scales, in the vertices' numbers: they keep the
+  // vertices' order, so every order and key the filling compares is one
+  // process's.
   std::vector<EdgeKey> mesh_edges;
   std::vector<Triangle> existing;
   {
     std::vector<EdgeKey> my_edges;
     std::vector<Triangle> my_triangles;
     edgesAndTrianglesAmong(
-        mine,
-        [&](VertexIndex v) { return std::binary_search(on_loops.begin(), on_loops.end(), v); },
-        my_edges, my_triangles);
+        mine, [&](VertexIndex v) { return on_loops.contains(v); }, my_edges, my_triangles);
     std::vector<std::vector<EdgeKey>> edges_out(processes);
     std::vector<std::vector<Triangle>> triangles_out(processes);
     for (EdgeKey key : my_edges)
-      edges_out[0].push_back(edgeKey(localOf(lowVertex(key)), localOf(highVertex(key))));
+      edges_out[0].push_back(edgeKey(on_loops(lowVertex(key)), on_loops(highVertex(key))));
     for (const Triangle &t : my_triangles)
-      triangles_out[0].push_back({localOf(t[0]), localOf(t[1]), localOf(t[2])});
+      triangles_out[0].push_back({on_loops(t[0]), on_loops(t[1]), on_loops(t[2])});
     deliver(edges_out, group, [&](EdgeKey key) { mesh_edges.push_back(key); });
     deliver(triangles_out, group, [&](const Triangle &t) { existing.push_back(t); });
   }
   const std::vector<LoopPoint> loop_points = valuesFromHomes<LoopPoint>(
-      on_zero ? on_loops : std::vector<VertexIndex>(), firsts, home_first,
+      on_zero ? on_loops.ids() : std::vector<VertexIndex>(), firsts, home_first,
       [&](std::size_t i) {
         return LoopPoint{{home_points[i].x(), home_points[i].y(), home_points[i].z()},
                          home_scales[i]};
@@ -152,13 +145,13 @@ HolesPart fillHolesInParts(const std::vector<Triangle> &mine, const MeshEdgesPar
     }
     for (std::vector<VertexIndex> &loop : chosen)
       for (VertexIndex &v : loop)
-        v = localOf(v);
+        v = on_loops(v);
     std::vector<Triangle> filling;
     part.filled = fillChosenLoops(chosen, points, SideLimit{&scales, rho}, std::move(mesh_edges),
                                   existing, filling);
     for (Triangle &t : filling)
       for (VertexIndex &v : t)
-        v = on_loops[v];
+        v = on_loops.id(v);
     part.loops = boundaryLoops(boundaryWithFilling(boundary, filling));
     filling_out[processes - 1] = std::move(filling);
   }

@@ -23,14 +23,9 @@ template <typename Measure>
 auto acrossSharedEdge(std::uint32_t t, std::uint32_t u, const std::vector<Triangle> &triangles,
                       const std::vector<Eigen::Vector3d> &points, const Measure &measure) {
   const EdgeKey edge = sharedEdge(triangles[t], triangles[u]);
-  const VertexIndex a = lowVertex(edge), b = highVertex(edge);
-  auto apex = [&](std::uint32_t triangle) {
-    for (VertexIndex v : triangles[triangle])
-      if (v != a && v != b)
-        return v;
-    return a;
-  };
-  return measure(points[a], points[b], points[apex(t)], points[apex(u)]);
+  return measure(points[lowVertex(edge)], points[highVertex(edge)],
+                 points[triangles[t][apexCorner(triangles[t], edge)]],
+                 points[triangles[u][apexCorner(triangles[u], edge)]]);
 }
 
 /// How much the surface bends across the edge that t and u share.

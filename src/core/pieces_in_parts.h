@@ -4,6 +4,8 @@
 // runs paired up, and the pieces they name numbered.
 #pragma once
 
+#include "numbering.h"
+
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -40,23 +42,7 @@ void forEachTrianglePair(std::vector<Side> &sides, const Visit &visit) {
 /// that a parity forest over the numbers, whose roots are its smallest
 /// numbers, roots each component at its first triangle as one process's
 /// forest does.
-class PieceNumbers {
-public:
-  explicit PieceNumbers(std::vector<std::uint64_t> pieces) : pieces_(std::move(pieces)) {
-    std::sort(pieces_.begin(), pieces_.end());
-    pieces_.erase(std::unique(pieces_.begin(), pieces_.end()), pieces_.end());
-  }
-  /// The number of a piece among those given.
-  std::uint32_t operator()(std::uint64_t piece) const {
-    return static_cast<std::uint32_t>(std::lower_bound(pieces_.begin(), pieces_.end(), piece) -
-                                      pieces_.begin());
-  }
-  std::uint64_t piece(std::uint32_t number) const { return pieces_[number]; }
-  std::size_t size() const { return pieces_.size(); }
-
-private:
-  std::vector<std::uint64_t> pieces_;
-};
+using PieceNumbers = Numbering<std::uint64_t>;
 
 } // namespace detail
 } // namespace pcl_ms

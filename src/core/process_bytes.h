@@ -127,12 +127,10 @@ template <typename Value, typename Make, typename Take>
 void gatherAtZero(std::size_t count, const Make &make, const Take &take, ProcessGroup &group) {
   constexpr std::size_t chunk = std::size_t{1} << 20;
   const std::vector<std::uint64_t> counts = countsOf(count, group);
-  std::vector<std::uint64_t> firsts(counts.size(), 0);
+  const std::vector<std::uint64_t> firsts = firstsOf(counts);
   std::uint64_t rounds = 0;
-  for (std::size_t p = 0; p < counts.size(); ++p) {
-    firsts[p] = p == 0 ? 0 : firsts[p - 1] + counts[p - 1];
-    rounds = std::max<std::uint64_t>(rounds, (counts[p] + chunk - 1) / chunk);
-  }
+  for (std::uint64_t of_one : counts)
+    rounds = std::max<std::uint64_t>(rounds, (of_one + chunk - 1) / chunk);
   for (std::uint64_t round = 0; round < rounds; ++round) {
     std::vector<std::vector<unsigned char>> outgoing(counts.size());
     const std::size_t begin = std::min<std::size_t>(count, round * chunk);

@@ -96,10 +96,7 @@ public:
       : home_(slice.points), first_(slice.first), total_(slice.total), parameters_(parameters),
         deadline_(deadline), group_(group), home_scale_(home_.positions.size(), 0.0f),
         home_pinch_(home_.positions.size(), 0) {
-    const std::vector<std::uint64_t> counts = countsOf(home_.positions.size(), group_);
-    home_first_.assign(1, 0);
-    for (std::uint64_t count : counts)
-      home_first_.push_back(home_first_.back() + count);
+    home_first_ = detail::firstsOf(countsOf(home_.positions.size(), group_));
   }
 
   SharedSurface run() {
@@ -129,9 +126,7 @@ private:
   }
 
   int homeOf(VertexIndex index) const {
-    return static_cast<int>(std::upper_bound(home_first_.begin(), home_first_.end(), index) -
-                            home_first_.begin()) -
-           1;
+    return static_cast<int>(detail::runHolding(home_first_, index));
   }
 
   PointRecord homeRecord(std::size_t i) const {

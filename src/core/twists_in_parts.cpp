@@ -54,14 +54,6 @@ double orderingBending(const Eigen::Vector3d &p, const Eigen::Vector3d &q, const
   return everything_sorted ? bendingAngle(p, q, t, s) : kruskalBending(p, q, t, s);
 }
 
-/// The corner of `corners` that is neither end of `key`, as an index 0-2.
-int apexOf(const Triangle &corners, EdgeKey key) {
-  for (int k = 0; k < 3; ++k)
-    if (corners[k] != lowVertex(key) && corners[k] != highVertex(key))
-      return k;
-  return 0;
-}
-
 int cornerOf(const Triangle &corners, VertexIndex v) {
   return corners[0] == v ? 0 : corners[1] == v ? 1 : 2;
 }
@@ -85,8 +77,8 @@ std::vector<PieceEdge> edgesOfSides(std::vector<TwistSide> &sides, bool everythi
     const Eigen::Vector3d p = pointOf(low, cornerOf(low.corners, lowVertex(key))),
                           q = pointOf(low, cornerOf(low.corners, highVertex(key)));
     const double bending =
-        orderingBending(p, q, pointOf(low, apexOf(low.corners, key)),
-                        pointOf(high, apexOf(high.corners, key)), everything_sorted);
+        orderingBending(p, q, pointOf(low, apexCorner(low.corners, key)),
+                        pointOf(high, apexCorner(high.corners, key)), everything_sorted);
     const auto differ = static_cast<std::uint8_t>(!consistentlyOriented(low.corners, high.corners) ^
                                                   low.flip ^ high.flip);
     // One edge per shared edge, as the lower triangle's slots list them.
@@ -140,8 +132,8 @@ TwistsPart twistForestInParts(const std::vector<Triangle> &mine, std::uint64_t f
       const EdgeKey key = sharedEdge(mine[t], mine[u]);
       const double bending =
           orderingBending(corners.of(lowVertex(key)), corners.of(highVertex(key)),
-                          corners.of(mine[t][apexOf(mine[t], key)]),
-                          corners.of(mine[u][apexOf(mine[u], key)]), everything_sorted);
+                          corners.of(mine[t][apexCorner(mine[t], key)]),
+                          corners.of(mine[u][apexCorner(mine[u], key)]), everything_sorted);
       if (!everything_sorted && bending < kruskal_flat_bending) {
         if (forest.join(static_cast<std::uint32_t>(t), static_cast<std::uint32_t>(u),
                         !consistentlyOriented(mine[t], mine[u])) == ParityForest::Join::conflict)
