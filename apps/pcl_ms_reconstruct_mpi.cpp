@@ -3,16 +3,17 @@
 // with the same options and the same triangles for any number of ranks.
 //
 // The ranks read their own byte ranges of a binary PCD or PLY, prepare them
-// together (pcl_ms::preparePointsTogether) and mesh them by owner
-// (pcl_ms::reconstructSlices): each rank its own buckets and seam zones, no
-// rank holding the cloud until rank 0 receives the surface to finish. A
-// file rank 0 reads whole (other formats) is meshed by a unit farm: rank 0
-// prepares it, builds the bucket tree and hands each bucket and seam zone
-// as a task to a free rank (pcl_ms_mpi::MpiUnitFarm), meshing one itself
-// meanwhile; the other ranks hold one unit at a time (docs/algorithm.md,
-// "Across processes"). Rank 0 finishes the surface (hole filling,
-// orientation) and writes the mesh. With -initial, or on one rank, rank 0
-// meshes the cloud alone, as pcl_ms_reconstruct does.
+// together (pcl_ms::preparePointsTogether), mesh them by owner and finish
+// the surface with the triangles in runs over the ranks
+// (pcl_ms::reconstructSlices): no rank holds the cloud or the surface until
+// rank 0 receives the finished triangles to write. A file rank 0 reads
+// whole (other formats) is meshed by a unit farm: rank 0 prepares it,
+// builds the bucket tree and hands each bucket and seam zone as a task to
+// a free rank (pcl_ms_mpi::MpiUnitFarm), meshing one itself meanwhile; the
+// other ranks hold one unit at a time, and rank 0 finishes the surface
+// (hole filling, orientation) (docs/algorithm.md, "Across processes").
+// Rank 0 writes the mesh. With -initial, or on one rank, rank 0 meshes the
+// cloud alone, as pcl_ms_reconstruct does.
 //
 // Failures: what every rank would see the same way (arguments, the file) is
 // agreed on and every rank exits with the same code; a failure on one rank
@@ -532,7 +533,7 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
   if (verbose) {
     pcl_ms_tools::printReconstructReport(result, load_ms, save_ms);
     printRankTable(figures);
-    // Where rank 0's memory goes beyond the others': it alone finishes.
+    // Rank 0's peaks (the unit farm: where it goes beyond the others', as it alone finishes).
     const pcl_ms::StagePeakMemory &peaks = result.peak_memory;
     pcl_ms_tools::printRow("rank 0 MB, meshed", "%10.1f", peaks.greedy / 1048576.0);
     pcl_ms_tools::printRow("rank 0 MB, finished", "%10.1f", peaks.finish / 1048576.0);

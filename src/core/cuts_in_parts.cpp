@@ -14,7 +14,7 @@ namespace pcl_ms {
 namespace detail {
 namespace {
 
-/// A triangle at a vertex to check, to process 0: its number in the list
+/// A triangle at a vertex to check, to the process grouping its fans: its number in the list
 /// the cut leaves, and its corners.
 struct AtVertex {
   VertexIndex vertex;
@@ -34,7 +34,7 @@ std::vector<VertexIndex> cornersOf(const std::vector<Triangle> &triangles,
   return corners;
 }
 
-/// Process 0's round: the triangles at each vertex to check grouped into
+/// A process's round: the triangles at each of its vertices to check grouped into
 /// fans, and those of all fans but the one to keep.
 std::vector<std::uint64_t> bowTieTriangles(std::vector<AtVertex> &at) {
   std::sort(at.begin(), at.end(), [](const AtVertex &a, const AtVertex &b) {
@@ -68,7 +68,8 @@ std::vector<std::uint64_t> bowTieTriangles(std::vector<AtVertex> &at) {
 } // namespace
 
 CutPart cutInParts(const std::vector<Triangle> &mine, std::uint64_t first,
-                   const std::vector<std::uint64_t> &to_cut, ProcessGroup &group) {
+                   const std::vector<std::uint64_t> &to_cut, ProcessGroup &group,
+                   const std::vector<VertexIndex> &also_check) {
   const auto processes = static_cast<std::size_t>(group.processes());
   const std::size_t count = mine.size();
   const std::vector<std::uint64_t> firsts = runFirsts(count, first, group, "cutInParts");
@@ -86,8 +87,10 @@ CutPart cutInParts(const std::vector<Triangle> &mine, std::uint64_t first,
     deliver(cut_out, group, [&](std::uint64_t t) { cut[static_cast<std::size_t>(t - first)] = 1; });
   }
   CutPart part;
-  std::vector<VertexIndex> check = cornersOf(mine, cut);
-  part.touched = check;
+  part.touched = cornersOf(mine, cut);
+  std::vector<VertexIndex> check;
+  std::set_union(part.touched.begin(), part.touched.end(), also_check.begin(), also_check.end(),
+                 std::back_inserter(check));
   std::vector<Triangle> left;
   for (std::size_t t = 0; t < count; ++t)
     if (!cut[t])
@@ -97,7 +100,9 @@ CutPart cutInParts(const std::vector<Triangle> &mine, std::uint64_t first,
   const std::uint64_t left_first = left_firsts[static_cast<std::size_t>(group.process())];
 
   // Bow-ties: rounds over the vertices to check, first the corners of the
-  // cut, then those of the triangles the last round split off.
+  // cut (and `also_check`), then those of the triangles the last round split
+  // off. Each vertex's fans are grouped by process v mod processes: the
+  // first round after the buckets checks every seam point.
   std::vector<std::uint8_t> split_off(left.size(), 0);
   while (true) {
     std::vector<VertexIndex> all_check;
@@ -114,7 +119,7 @@ CutPart cutInParts(const std::vector<Triangle> &mine, std::uint64_t first,
       if (!split_off[t])
         for (VertexIndex v : left[t])
           if (std::binary_search(all_check.begin(), all_check.end(), v))
-            at_out[0].push_back({v, left_first + t, left[t]});
+            at_out[v % processes].push_back({v, left_first + t, left[t]});
     std::vector<AtVertex> at;
     deliver(at_out, group, [&](const AtVertex &one) { at.push_back(one); });
     std::vector<std::vector<std::uint64_t>> going_out(processes);

@@ -31,16 +31,21 @@ struct CutPart {
 
 /// Collective. `mine` is this process's run of the list, from whole-list
 /// number `first` on (the runs follow each other in process order);
-/// `to_cut` whole-list numbers of triangles to cut, given on any process.
+/// `to_cut` whole-list numbers of triangles to cut, given on any process;
+/// `also_check` vertices (ascending, each once) whose fans are checked in
+/// the first round besides the cut's corners (after the buckets: the seams'
+/// points, as one process's splitBowTies() is given them).
 /// The same as one process's dropTriangles() then splitBowTies() without
 /// fixed triangles (the tool meshes clouds with initial triangles on one
 /// process): each round, the triangles at the vertices to check go to
-/// process 0 with their numbers in the list the cut leaves, which groups
-/// them into fans as one process does and sends back those to go. Throws
+/// process v mod processes with their numbers in the list the cut leaves,
+/// which groups them into fans as one process does and sends back those to
+/// go. Throws
 /// std::invalid_argument on every process when the runs do not follow each
 /// other from 0 or a number to cut is beyond the list.
 CutPart cutInParts(const std::vector<Triangle> &mine, std::uint64_t first,
-                   const std::vector<std::uint64_t> &to_cut, ProcessGroup &group);
+                   const std::vector<std::uint64_t> &to_cut, ProcessGroup &group,
+                   const std::vector<VertexIndex> &also_check = {});
 
 } // namespace detail
 } // namespace pcl_ms

@@ -43,7 +43,7 @@ FinishedPart finishInParts(const std::vector<Triangle> &mine, std::uint64_t firs
       edges = MeshEdgesPart(); // not held while the new ones are made
       edges = meshEdgesInParts(part.triangles, part.first, point_count, group);
     }
-    const ComponentsPart components = componentsInParts(part.triangles, part.first, edges, group);
+    ComponentsPart components = componentsInParts(part.triangles, part.first, edges, group);
     const CornerPoints corners =
         cornerPointsFromHomes(part.triangles, home_points, home_first, group);
     const std::vector<std::uint8_t> side_turns =
@@ -53,8 +53,11 @@ FinishedPart finishInParts(const std::vector<Triangle> &mine, std::uint64_t firs
     for (std::size_t t = 0; t < part.triangles.size(); ++t)
       if (side_turns[t] ^ twists.flipped[t])
         std::swap(part.triangles[t][1], part.triangles[t][2]);
-    return conflictCutsInParts(part.triangles, part.first, edges, components, corners,
-                               twists.conflicts, viewpoint, group);
+    std::vector<std::uint64_t> cuts = conflictCutsInParts(
+        part.triangles, part.first, edges, components, corners, twists.conflicts, viewpoint, group);
+    part.component = std::move(components.component);
+    part.orientable = std::move(components.orientable);
+    return cuts;
   };
   std::vector<std::uint64_t> to_cut = fillThenOrient(fill_holes_max_edges, nullptr);
   for (int round = 0; round < max_untwist_rounds && totalOver(to_cut.size(), group) > 0; ++round) {

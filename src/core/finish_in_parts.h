@@ -22,6 +22,11 @@ struct FinishedPart {
   /// on (fillings join the last process's run).
   std::vector<Triangle> triangles;
   std::uint64_t first = 0;
+  /// Per triangle of the run: the whole-list number of its component's
+  /// first triangle, and 1 where that component is orientable (finishSurface()
+  /// numbers the components in the order of their first triangles).
+  std::vector<std::uint64_t> component;
+  std::vector<std::uint8_t> orientable;
   /// On process 0: the boundary loops, as finishSurface() traces them.
   std::vector<std::vector<VertexIndex>> boundary_loops;
   /// On every process: the whole list's figures.

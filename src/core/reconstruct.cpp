@@ -310,10 +310,14 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
 
 Result meshPrepared(const PreparedPoints &prepared, const std::vector<Triangle> &initial_triangles,
                     const Parameters &parameters, BucketExchange &exchange,
-                    const Deadline &deadline, Clock::time_point start, Result result,
-                    BucketedSurface *meshed = nullptr);
+                    const Deadline &deadline, Clock::time_point start, Result result);
 
 /// The checks every entry point makes before any work.
+/// The medial axis of the finished surface, into `result` (Parameters::compute_medial_axis).
+void addMedialAxis(const PreparedPoints &prepared, const std::vector<Triangle> &triangles,
+                   const Deadline &deadline, Result &result);
+/// The finished surface into `result`, in the user's records.
+void takeFinishedSurface(FinishedSurface &&surface, const PreparedPoints &prepared, Result &result);
 void checkParameters(const Parameters &parameters, bool has_normals) {
   const std::string invalid = parameters.validate();
   if (!invalid.empty())
@@ -366,23 +370,26 @@ Result reconstructSlices(PreparedSlice &&slice, const Parameters &parameters, Pr
     result.peak_memory.prepare = peakResidentBytes();
     return meshPrepared(joined, {}, parameters, one_process, deadline, start, std::move(result));
   }
+  result.peak_memory.prepare = peakResidentBytes();
   SharedSurface shared = meshSlicesInBuckets(slice, parameters, &deadline, group);
   slice = PreparedSlice();
   returnFreeHeapPages();
-  result.peak_memory.prepare = peakResidentBytes();
-  if (group.process() != 0) {
-    result.d_med = shared.surface.d_med;
-    result.d_max = parameters.rho * shared.surface.d_med;
-    result.bucket_statistics = shared.surface.statistics;
-    result.timings.delaunay = shared.surface.delaunay_seconds;
-    result.timings.scaffold = shared.surface.scaffold_seconds;
-    result.timings.greedy = shared.surface.greedy_seconds;
-    result.timings.total = secondsSince(start);
-    return result;
+  result.d_med = shared.surface.d_med;
+  result.d_max = parameters.rho * shared.surface.d_med;
+  result.bucket_statistics = shared.surface.statistics;
+  result.timings.delaunay = shared.surface.delaunay_seconds;
+  result.timings.scaffold = shared.surface.scaffold_seconds;
+  result.timings.greedy = shared.surface.greedy_seconds;
+  result.timings.finish = shared.finish_seconds;
+  result.peak_memory.scaffold = result.peak_memory.greedy = result.peak_memory.finish =
+      std::max(result.peak_memory.prepare, peakResidentBytes());
+  if (group.process() == 0) {
+    if (parameters.compute_medial_axis)
+      addMedialAxis(shared.points, shared.finished.triangles, deadline, result);
+    takeFinishedSurface(std::move(shared.finished), shared.points, result);
   }
-  const PreparedPoints points = std::move(shared.points);
-  return meshPrepared(points, {}, parameters, one_process, deadline, start, std::move(result),
-                      &shared.surface);
+  result.timings.total = secondsSince(start);
+  return result;
 }
 
 namespace {
@@ -406,12 +413,10 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
 }
 
 /// Stages 2 to 4 on prepared points, into `result` (which has the
-/// preparation's figures). `meshed`, if given, is their surface in buckets,
-/// meshed elsewhere: only the finishing is left.
+/// preparation's figures).
 Result meshPrepared(const PreparedPoints &prepared, const std::vector<Triangle> &initial_triangles,
                     const Parameters &parameters, BucketExchange &exchange,
-                    const Deadline &deadline, Clock::time_point start, Result result,
-                    BucketedSurface *meshed) {
+                    const Deadline &deadline, Clock::time_point start, Result result) {
   Clock::time_point stage;
   const bool preferred_mode = parameters.initial_triangles_mode == InitialTrianglesMode::preferred;
   const std::vector<Triangle> fixed = preferred_mode
@@ -428,8 +433,8 @@ Result meshPrepared(const PreparedPoints &prepared, const std::vector<Triangle> 
   std::vector<Triangle> greedy_triangles; // what the finish starts from, with seams
   std::vector<float> local_scale;         // per distinct point
   // Initial triangles and seams are honoured by the one-piece path only.
-  const bool in_buckets = meshed || (initial_triangles.empty() && !parameters.allow_non_manifold &&
-                                     usesBuckets(prepared.positions.size(), parameters));
+  const bool in_buckets = initial_triangles.empty() && !parameters.allow_non_manifold &&
+                          usesBuckets(prepared.positions.size(), parameters);
   // Only process 0 meshes a one-piece cloud and finishes the surface.
   const bool gathers = exchange.process() == 0;
   if (!in_buckets && !gathers)
@@ -437,8 +442,7 @@ Result meshPrepared(const PreparedPoints &prepared, const std::vector<Triangle> 
   if (in_buckets) {
     deadline.check("the preparation");
     BucketedSurface bucketed =
-        meshed ? std::move(*meshed)
-               : meshInBuckets(prepared.positions, normals, parameters, &deadline, &exchange);
+        meshInBuckets(prepared.positions, normals, parameters, &deadline, &exchange);
     returnFreeHeapPages();
     triangles = std::move(bucketed.triangles);
     local_scale = std::move(bucketed.local_scale);
@@ -524,24 +528,8 @@ Result meshPrepared(const PreparedPoints &prepared, const std::vector<Triangle> 
     result.initial_kept = countKept(fixed.empty() ? preferred : fixed, surface.triangles);
   result.timings.finish = secondsSince(stage);
   result.peak_memory.finish = std::max(result.peak_memory.greedy, peakResidentBytes());
-  if (parameters.compute_medial_axis) {
-    // Read off a Delaunay triangulation of all prepared points (buckets
-    // never had one of the whole cloud); nothing of this runs when off.
-    stage = Clock::now();
-    MedialAxis axis = computeMedialAxis(prepared.positions, surface.triangles);
-    for (Eigen::Vector3d &position : axis.node_positions)
-      position += prepared.centre;
-    result.medial_axis = std::move(axis);
-    result.timings.medial_axis = secondsSince(stage);
-    deadline.check("the medial axis");
-  }
-  // Back to the user's records.
-  for (Triangle &triangle : surface.triangles)
-    for (VertexIndex &v : triangle)
-      v = prepared.user_index[v];
-  for (auto &loop : surface.boundary_loops)
-    for (VertexIndex &v : loop)
-      v = prepared.user_index[v];
+  if (parameters.compute_medial_axis)
+    addMedialAxis(prepared, surface.triangles, deadline, result);
   for (auto &edge : seam_edges) {
     edge = {prepared.user_index[edge[0]], prepared.user_index[edge[1]]};
     if (edge[0] > edge[1])
@@ -549,14 +537,38 @@ Result meshPrepared(const PreparedPoints &prepared, const std::vector<Triangle> 
   }
   std::sort(seam_edges.begin(), seam_edges.end());
   result.seam_edges = std::move(seam_edges);
+  takeFinishedSurface(std::move(surface), prepared, result);
+  result.timings.total = secondsSince(start);
+  return result;
+}
+
+void addMedialAxis(const PreparedPoints &prepared, const std::vector<Triangle> &triangles,
+                   const Deadline &deadline, Result &result) {
+  // Read off a Delaunay triangulation of all prepared points (buckets
+  // never had one of the whole cloud); nothing of this runs when off.
+  const Clock::time_point stage = Clock::now();
+  MedialAxis axis = computeMedialAxis(prepared.positions, triangles);
+  for (Eigen::Vector3d &position : axis.node_positions)
+    position += prepared.centre;
+  result.medial_axis = std::move(axis);
+  result.timings.medial_axis = secondsSince(stage);
+  deadline.check("the medial axis");
+}
+
+void takeFinishedSurface(FinishedSurface &&surface, const PreparedPoints &prepared,
+                         Result &result) {
+  for (Triangle &triangle : surface.triangles)
+    for (VertexIndex &v : triangle)
+      v = prepared.user_index[v];
+  for (auto &loop : surface.boundary_loops)
+    for (VertexIndex &v : loop)
+      v = prepared.user_index[v];
   result.triangles = std::move(surface.triangles);
   result.boundary_loops = std::move(surface.boundary_loops);
   result.triangle_component = std::move(surface.triangle_component);
   result.component_orientable = std::move(surface.component_orientable);
   result.holes_filled = surface.holes_filled;
   result.twist_triangles_removed = surface.twist_triangles_removed;
-  result.timings.total = secondsSince(start);
-  return result;
 }
 
 } // namespace

@@ -13,6 +13,8 @@
 #include <pcl_ms/reconstruct.h>
 
 #include "bucket_parts.h"
+#include "cuts_in_parts.h"
+#include "finish_in_parts.h"
 #include "median_spacing.h"
 #include "process_bytes.h"
 #include "shared_tree.h"
@@ -36,6 +38,7 @@ using detail::Box;
 using detail::bytesOf;
 using detail::countsOf;
 using detail::deliver;
+using detail::fromZeroToAll;
 using detail::gatherAtZero;
 using detail::totalOver;
 using detail::valuesOf;
@@ -81,10 +84,21 @@ struct ScaleFor {
   float scale;
 };
 
-struct TriangleFor {
+/// A triangle of a subtree at a seam zone's points, to the zone's owner:
+/// its segment's place in the whole list's order and its place in the segment.
+struct FixedFor {
   Triangle triangle;
-  std::uint32_t node;
+  std::uint32_t segment, index, unit;
 };
+static_assert(sizeof(FixedFor) == 24, "travels as bytes, without padding");
+
+/// A triangle of the whole list, to the process whose run holds `place`.
+struct PlacedTriangle {
+  Triangle triangle;
+  std::uint32_t padding = 0;
+  std::uint64_t place;
+};
+static_assert(sizeof(PlacedTriangle) == 24, "travels as bytes, without padding");
 
 using Node = detail::TreeNode;
 
@@ -112,6 +126,27 @@ private:
 
   void buildTree() {
     tree_ = buildSharedTree(home_.positions, first_, parameters_, group_);
+    // The whole list is the segments of the tree's nodes (a leaf's
+    // triangles, an inner node's seam) in post-order: a node's subtree, then
+    // its seam.
+    segment_order_.assign(tree_.nodes.size(), 0);
+    std::uint32_t next = 0;
+    std::vector<std::pair<int, bool>> stack;
+    if (tree_.root >= 0)
+      stack.push_back({tree_.root, false});
+    while (!stack.empty()) {
+      const std::pair<int, bool> top = stack.back();
+      stack.pop_back();
+      const Node &node = tree_.nodes[static_cast<std::size_t>(top.first)];
+      if (top.second || node.axis < 0) {
+        segment_order_[static_cast<std::size_t>(top.first)] = next++;
+        continue;
+      }
+      stack.push_back({top.first, true});
+      stack.push_back({node.children[1], false});
+      stack.push_back({node.children[0], false});
+    }
+    segment_count_ = next;
     statistics_.buckets = tree_.leaves.size();
     for (const Node &node : tree_.nodes)
       statistics_.seam_zones += node.axis >= 0;
@@ -390,9 +425,6 @@ private:
             visit(i);
   }
 
-  /// The triangles kept so far in node's subtree, on the node's owner.
-  std::vector<Triangle> &trianglesOf(int node) { return node_triangles_[node]; }
-
   void stitchLevel(int depth) {
     const Clock::time_point stage = Clock::now();
     if (depth == tree_.max_depth) {
@@ -438,46 +470,82 @@ private:
     deliver(outgoing, group_,
             [&](const PointFor &arrived) { zone_points[arrived.unit].push_back(arrived.point); });
 
-    // Each zone's second subtree's triangles to the zone's owner.
-    std::vector<std::vector<TriangleFor>> moving(processes);
-    for (int node : level) {
-      const int second = tree_.nodes[static_cast<std::size_t>(node)].children[1];
-      if (zoneOwner(second) == me && zoneOwner(node) != me) {
-        for (const Triangle &triangle : trianglesOf(second))
-          moving[static_cast<std::size_t>(zoneOwner(node))].push_back(
-              {triangle, static_cast<std::uint32_t>(second)});
-        std::vector<Triangle>().swap(trianglesOf(second));
+    // Each zone's point numbers, from its owner, to the processes holding
+    // triangles of its subtree (the owners of its leaves), which send back
+    // those at the zone's points: the triangles the zone keeps fixed. The
+    // triangles stay on the processes that made them.
+    std::vector<std::vector<VertexIndex>> zone_indices(level.size());
+    std::vector<std::vector<FixedFor>> fixed_parts(level.size());
+    {
+      std::vector<std::vector<IndexFor>> zone_out(processes);
+      for (std::size_t z = 0; z < level.size(); ++z) {
+        if (zoneOwner(level[z]) != me)
+          continue;
+        std::vector<PointRecord> &points = zone_points[z];
+        std::sort(points.begin(), points.end(),
+                  [](const PointRecord &a, const PointRecord &b) { return a.index < b.index; });
+        for (const PointRecord &point : points)
+          zone_indices[z].push_back(point.index);
+        const Node &node = tree_.nodes[static_cast<std::size_t>(level[z])];
+        int holder = -1;
+        for (std::uint32_t leaf = node.first_leaf; leaf < node.end_leaf; ++leaf)
+          if (ownerOf(leaf) != holder) { // the leaves' owners ascend
+            holder = ownerOf(leaf);
+            for (VertexIndex v : zone_indices[z])
+              zone_out[static_cast<std::size_t>(holder)].push_back(
+                  {v, static_cast<std::uint32_t>(z)});
+          }
       }
+      std::vector<std::vector<VertexIndex>> asked(level.size());
+      deliver(zone_out, group_, [&](const IndexFor &one) { asked[one.unit].push_back(one.index); });
+      std::vector<std::vector<FixedFor>> fixed_out(processes);
+      for (std::size_t z = 0; z < level.size(); ++z) {
+        if (asked[z].empty())
+          continue;
+        const Node &node = tree_.nodes[static_cast<std::size_t>(level[z])];
+        const auto owner = static_cast<std::size_t>(zoneOwner(level[z]));
+        auto atZone = [&](VertexIndex v) {
+          return std::binary_search(asked[z].begin(), asked[z].end(), v);
+        };
+        for (const auto &held : node_triangles_) {
+          const Node &segment = tree_.nodes[static_cast<std::size_t>(held.first)];
+          if (held.first == level[z] || segment.first_leaf < node.first_leaf ||
+              segment.end_leaf > node.end_leaf)
+            continue;
+          const std::vector<Triangle> &triangles = held.second;
+          for (std::size_t i = 0; i < triangles.size(); ++i)
+            if (atZone(triangles[i][0]) || atZone(triangles[i][1]) || atZone(triangles[i][2]))
+              fixed_out[owner].push_back(
+                  {triangles[i], segment_order_[static_cast<std::size_t>(held.first)],
+                   static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(z)});
+        }
+      }
+      deliver(fixed_out, group_,
+              [&](const FixedFor &one) { fixed_parts[one.unit].push_back(one); });
     }
-    deliver(moving, group_, [&](const TriangleFor &arrived) {
-      trianglesOf(static_cast<int>(arrived.node)).push_back(arrived.triangle);
-    });
 
     // The fixed triangles' corners outside the zone, from their homes.
-    std::vector<std::vector<VertexIndex>> zone_indices(level.size());
     std::vector<std::vector<IndexFor>> requests(processes);
     std::vector<std::vector<Triangle>> fixed(level.size());
     for (std::size_t z = 0; z < level.size(); ++z) {
       if (zoneOwner(level[z]) != me)
         continue;
-      std::vector<PointRecord> &points = zone_points[z];
-      std::sort(points.begin(), points.end(),
-                [](const PointRecord &a, const PointRecord &b) { return a.index < b.index; });
-      for (const PointRecord &point : points)
-        zone_indices[z].push_back(point.index);
       auto inZone = [&](VertexIndex v) {
         return std::binary_search(zone_indices[z].begin(), zone_indices[z].end(), v);
       };
+      // In the order of the subtree's list: its segments in the tree's order.
+      std::vector<FixedFor> &parts = fixed_parts[z];
+      std::sort(parts.begin(), parts.end(), [](const FixedFor &a, const FixedFor &b) {
+        return a.segment < b.segment || (a.segment == b.segment && a.index < b.index);
+      });
       std::vector<VertexIndex> frozen;
-      for (int child : tree_.nodes[static_cast<std::size_t>(level[z])].children)
-        for (const Triangle &triangle : trianglesOf(child)) {
-          if (!(inZone(triangle[0]) || inZone(triangle[1]) || inZone(triangle[2])))
-            continue;
-          fixed[z].push_back(triangle);
-          for (VertexIndex v : triangle)
-            if (!inZone(v))
-              frozen.push_back(v);
-        }
+      for (const FixedFor &part : parts) {
+        fixed[z].push_back(part.triangle);
+        for (VertexIndex v : part.triangle)
+          if (!inZone(v))
+            frozen.push_back(v);
+      }
+      std::vector<FixedFor>().swap(parts);
       std::sort(frozen.begin(), frozen.end());
       frozen.erase(std::unique(frozen.begin(), frozen.end()), frozen.end());
       for (VertexIndex v : frozen)
@@ -549,17 +617,9 @@ private:
       }
       seam_figures_[0] += static_cast<double>(core_points[k]);
       seam_figures_[1] += static_cast<double>(outcome.triangles.size());
-      // The subtree's triangles, then the seam's, in a fixed order.
-      std::vector<Triangle> &merged = trianglesOf(node);
-      const int *children = tree_.nodes[static_cast<std::size_t>(node)].children;
-      merged.reserve(trianglesOf(children[0]).size() + trianglesOf(children[1]).size() +
-                     added.size());
-      for (int c = 0; c < 2; ++c) {
-        std::vector<Triangle> &part = trianglesOf(children[c]);
-        merged.insert(merged.end(), part.begin(), part.end());
-        std::vector<Triangle>().swap(part);
-      }
-      merged.insert(merged.end(), added.begin(), added.end());
+      // The seam's segment of the whole list, after its subtree's.
+      if (!added.empty())
+        node_triangles_[node] = std::move(added);
       progress_->unitDone();
     }
     deliver(pinches, group_, [&](const IndexFor &pinch) { home_pinch_[pinch.index - first_] = 1; });
@@ -617,7 +677,7 @@ private:
     return meshBucket(task, parameters_, deadline_);
   }
 
-  // ---- the end: everything to process 0 --------------------------------------------
+  // ---- the end: the list in runs, split, finished, then to process 0 ---------
 
   SharedSurface finish() {
     std::vector<double> figures{seam_figures_[0], seam_figures_[1], seam_figures_[2],
@@ -637,36 +697,145 @@ private:
     surface.delaunay_seconds = static_cast<double>(sums[3]) * 1e-6;
     surface.scaffold_seconds = static_cast<double>(sums[4]) * 1e-6;
     surface.greedy_seconds = static_cast<double>(sums[5]) * 1e-6;
-    surface.statistics = statistics_;
 
-    // The points and what their homes know of them, in the prepared order.
-    struct HomeFigures {
-      float scale;
-      std::uint32_t pinch;
-    };
-    shared.points = joinSlicesAtProcessZero(home_, parameters_.use_normals, group_);
-    std::vector<bool> may_pinch;
-    if (group_.process() == 0) {
-      surface.local_scale.resize(total_);
-      may_pinch.resize(total_);
+    const Clock::time_point stage = Clock::now();
+    std::uint64_t first = 0;
+    std::vector<Triangle> run = wholeListInRuns(first);
+    // The bow-ties the seams may have made, at the seams' points (as
+    // meshInBuckets splits them).
+    std::vector<VertexIndex> pinches;
+    for (std::size_t i = 0; i < home_pinch_.size(); ++i)
+      if (home_pinch_[i])
+        pinches.push_back(globalIndex(i));
+    std::vector<std::uint8_t>().swap(home_pinch_);
+    detail::CutPart split = detail::cutInParts(run, first, {}, group_, pinches);
+    std::vector<Triangle>().swap(run);
+    statistics_.bow_tie_triangles_removed = split.split_off;
+    surface.statistics = statistics_;
+    if (deadline_)
+      deadline_->check("the bow-tie split");
+
+    // Where no bucket measured a point's scale, the cloud's spacing stands in.
+    std::vector<float> scales(home_scale_);
+    for (float &scale : scales)
+      if (!(scale > 0))
+        scale = static_cast<float>(d_med_);
+    Eigen::Vector3d viewpoint;
+    if (parameters_.viewpoint)
+      viewpoint = Eigen::Vector3d((*parameters_.viewpoint)[0], (*parameters_.viewpoint)[1],
+                                  (*parameters_.viewpoint)[2]) -
+                  home_.centre;
+    detail::FinishedPart part = detail::finishInParts(
+        split.kept, split.first, home_.positions, scales, first_, parameters_.fill_holes_max_edges,
+        parameters_.rho, parameters_.viewpoint ? &viewpoint : nullptr, group_);
+    split = detail::CutPart();
+    std::vector<float>().swap(scales);
+    shared.finish_seconds = secondsSince(stage);
+    if (deadline_)
+      deadline_->check("the finish");
+    gatherFinished(part, shared);
+    return shared;
+  }
+
+  /// The segments of the whole list, from the processes that made them, in
+  /// runs of equal length following each other in process order; `first`
+  /// is this process's run's first number.
+  std::vector<Triangle> wholeListInRuns(std::uint64_t &first) {
+    std::vector<std::uint64_t> segment_first(segment_count_ + 1, 0);
+    for (const auto &held : node_triangles_)
+      segment_first[segment_order_[static_cast<std::size_t>(held.first)] + 1] = held.second.size();
+    group_.sum(segment_first);
+    for (std::size_t s = 1; s < segment_first.size(); ++s)
+      segment_first[s] += segment_first[s - 1];
+    const std::uint64_t total = segment_first.back();
+    const auto processes = static_cast<std::uint64_t>(group_.processes());
+    std::vector<std::uint64_t> run_first(processes + 1);
+    for (std::uint64_t p = 0; p <= processes; ++p)
+      run_first[p] = total * p / processes;
+    const auto me = static_cast<std::size_t>(group_.process());
+    first = run_first[me];
+    std::vector<std::vector<PlacedTriangle>> outgoing(processes);
+    for (auto &held : node_triangles_) {
+      std::uint64_t place = segment_first[segment_order_[static_cast<std::size_t>(held.first)]];
+      for (const Triangle &triangle : held.second) {
+        outgoing[detail::runHolding(run_first, place)].push_back({triangle, 0, place});
+        ++place;
+      }
+      std::vector<Triangle>().swap(held.second);
     }
-    gatherAtZero<HomeFigures>(
-        home_.positions.size(),
-        [&](std::size_t i) {
-          return HomeFigures{home_scale_[i] > 0 ? home_scale_[i] : static_cast<float>(d_med_),
-                             home_pinch_[i]};
+    std::unordered_map<int, std::vector<Triangle>>().swap(node_triangles_);
+    std::vector<Triangle> run(static_cast<std::size_t>(run_first[me + 1] - first));
+    deliver(outgoing, group_, [&](const PlacedTriangle &arrived) {
+      run[static_cast<std::size_t>(arrived.place - first)] = arrived.triangle;
+    });
+    return run;
+  }
+
+  /// Process 0 gets the finished surface: the triangles, their components
+  /// numbered in the order of their first triangles, the loops, the
+  /// figures, and every point's record in the user's cloud.
+  void gatherFinished(detail::FinishedPart &part, SharedSurface &shared) {
+    FinishedSurface &finished = shared.finished;
+    finished.holes_filled = part.holes_filled;
+    finished.twist_triangles_removed = part.twist_triangles_removed;
+    finished.boundary_loops = std::move(part.boundary_loops);
+    // Every component's first triangle, with whether it is orientable, to all.
+    struct ComponentStart {
+      std::uint64_t first;
+      std::uint64_t orientable;
+    };
+    std::vector<ComponentStart> starts;
+    {
+      std::vector<ComponentStart> mine;
+      for (std::size_t t = 0; t < part.triangles.size(); ++t)
+        if (part.component[t] == part.first + t)
+          mine.push_back({part.component[t], part.orientable[t]});
+      const std::uint64_t components = totalOver(mine.size(), group_);
+      if (group_.process() == 0)
+        starts.resize(components);
+      gatherAtZero<ComponentStart>(
+          mine.size(), [&](std::size_t i) { return mine[i]; },
+          [&](std::size_t c, const ComponentStart &start) { starts[c] = start; }, group_);
+      fromZeroToAll(starts, group_);
+    }
+    struct NumberedTriangle {
+      Triangle corners;
+      std::uint32_t component;
+    };
+    const bool zero = group_.process() == 0;
+    const std::uint64_t total = totalOver(part.triangles.size(), group_);
+    if (zero) {
+      finished.triangles.resize(total);
+      finished.triangle_component.resize(total);
+      for (const ComponentStart &start : starts)
+        finished.component_orientable.push_back(start.orientable != 0);
+    }
+    gatherAtZero<NumberedTriangle>(
+        part.triangles.size(),
+        [&](std::size_t t) {
+          const auto at = std::lower_bound(
+              starts.begin(), starts.end(), part.component[t],
+              [](const ComponentStart &a, std::uint64_t b) { return a.first < b; });
+          return NumberedTriangle{part.triangles[t],
+                                  static_cast<std::uint32_t>(at - starts.begin())};
         },
-        [&](std::size_t v, const HomeFigures &figures) {
-          surface.local_scale[v] = figures.scale;
-          may_pinch[v] = figures.pinch != 0;
+        [&](std::size_t t, const NumberedTriangle &triangle) {
+          finished.triangles[t] = triangle.corners;
+          finished.triangle_component[t] = triangle.component;
         },
         group_);
-    if (group_.process() != 0)
-      return shared;
-    surface.triangles = std::move(trianglesOf(tree_.root));
-    surface.statistics.bow_tie_triangles_removed =
-        splitBowTies(surface.triangles, total_, may_pinch);
-    return shared;
+    part = detail::FinishedPart();
+    // The points' records; their positions only for the medial axis.
+    shared.points.centre = home_.centre;
+    if (parameters_.compute_medial_axis) {
+      shared.points = joinSlicesAtProcessZero(home_, false, group_);
+      return;
+    }
+    if (zero)
+      shared.points.user_index.resize(total_);
+    gatherAtZero<VertexIndex>(
+        home_.user_index.size(), [&](std::size_t i) { return home_.user_index[i]; },
+        [&](std::size_t v, VertexIndex record) { shared.points.user_index[v] = record; }, group_);
   }
 
   const PreparedPoints &home_;
@@ -684,7 +853,10 @@ private:
 
   std::vector<std::uint32_t> own_leaves_; // ascending
   std::vector<std::vector<Triangle>> leaf_triangles_;
+  /// The segments of the whole list this process made, by node.
   std::unordered_map<int, std::vector<Triangle>> node_triangles_;
+  std::vector<std::uint32_t> segment_order_; // by node
+  std::uint32_t segment_count_ = 0;
   std::unique_ptr<detail::ProgressReporter> progress_;
   double d_med_ = 0;
   BucketStatistics statistics_;

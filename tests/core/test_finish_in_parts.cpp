@@ -101,6 +101,27 @@ TEST(FinishInParts, TheSurfaceIsOneProcesssForAnySplitWithOrWithoutAViewpoint) {
                                          rho, view, group);
       });
       std::vector<Triangle> finished;
+      // Components numbered by their first triangles, as one process numbers them.
+      std::vector<std::uint64_t> component_firsts;
+      std::vector<std::uint32_t> triangle_component;
+      std::vector<bool> component_orientable;
+      for (int p = 0; p < processes; ++p) {
+        const detail::FinishedPart &part = parts[static_cast<std::size_t>(p)];
+        ASSERT_EQ(part.component.size(), part.triangles.size());
+        ASSERT_EQ(part.orientable.size(), part.triangles.size());
+        for (std::size_t t = 0; t < part.triangles.size(); ++t) {
+          if (part.component[t] == part.first + t) {
+            component_firsts.push_back(part.component[t]);
+            component_orientable.push_back(part.orientable[t] != 0);
+          }
+          const auto at =
+              std::lower_bound(component_firsts.begin(), component_firsts.end(), part.component[t]);
+          ASSERT_NE(at, component_firsts.end());
+          triangle_component.push_back(static_cast<std::uint32_t>(at - component_firsts.begin()));
+        }
+      }
+      EXPECT_EQ(triangle_component, expected.triangle_component);
+      EXPECT_EQ(component_orientable, expected.component_orientable);
       for (int p = 0; p < processes; ++p) {
         const detail::FinishedPart &part = parts[static_cast<std::size_t>(p)];
         EXPECT_EQ(part.first, finished.size()) << "process " << p;

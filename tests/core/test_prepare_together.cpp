@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <string>
 
 namespace {
@@ -218,8 +219,15 @@ void expectOneProcessMesh(const std::vector<float> &xyz, const std::vector<float
     EXPECT_EQ(results[0].triangles, reference.triangles) << where;
     EXPECT_EQ(results[0].boundary_loops, reference.boundary_loops) << where;
     EXPECT_EQ(results[0].triangle_component, reference.triangle_component) << where;
+    EXPECT_EQ(results[0].component_orientable, reference.component_orientable) << where;
     EXPECT_EQ(results[0].holes_filled, reference.holes_filled) << where;
+    EXPECT_EQ(results[0].twist_triangles_removed, reference.twist_triangles_removed) << where;
     EXPECT_EQ(results[0].d_med, reference.d_med) << where;
+    ASSERT_EQ(results[0].medial_axis.has_value(), reference.medial_axis.has_value()) << where;
+    if (reference.medial_axis) {
+      EXPECT_EQ(results[0].medial_axis->node_positions, reference.medial_axis->node_positions)
+          << where;
+    }
     for (const pcl_ms::Result &result : results) {
       // One piece is process 0's alone; the buckets' figures are everyone's.
       if (expected.buckets > 0) {
@@ -255,6 +263,32 @@ TEST(BucketsByOwner, GridAndNormalsGiveTheOneProcessMesh) {
   parameters.use_normals = true;
   parameters.num_threads = 2;
   expectOneProcessMesh(xyz, normalsFor(xyz), parameters, {{0.4, 0.45}});
+}
+
+TEST(BucketsByOwner, AViewpointAndTheMedialAxisGiveTheOneProcessSurface) {
+  // Finished in parts, the triangles turned towards the viewpoint; the
+  // medial axis from the points process 0 receives at the end.
+  pcl_ms::Parameters parameters;
+  parameters.bucket_points = 3000;
+  parameters.viewpoint = {{0.3, 0.4, 1.5}};
+  parameters.compute_medial_axis = true;
+  expectOneProcessMesh(awkwardBunny(), {}, parameters, {{0.5}, {0.1, 0.3, 0.8}});
+}
+
+TEST(BucketsByOwner, ANoisyBunnyGivesTheOneProcessSurface) {
+  // Noise makes bow-ties at the seams (split in parts after the buckets)
+  // and twists that the finishing cuts and refills.
+  std::vector<float> xyz = awkwardBunny();
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> shake(-0.0005f, 0.0005f);
+  for (float &coordinate : xyz)
+    coordinate += shake(random);
+  pcl_ms::Parameters parameters;
+  parameters.bucket_points = 2000;
+  const pcl_ms::Result reference = pcl_ms::reconstruct(viewOf(xyz), parameters);
+  ASSERT_GT(reference.bucket_statistics.bow_tie_triangles_removed, 0u);
+  ASSERT_GT(reference.twist_triangles_removed, 0u);
+  expectOneProcessMesh(xyz, {}, parameters, {{0.5}, {0.2, 0.6, 0.7}});
 }
 
 TEST(BucketsByOwner, OnePieceIsMeshedByProcessZero) {

@@ -7,6 +7,7 @@
 
 #include <pcl_ms/buckets.h>
 #include <pcl_ms/deadline.h>
+#include <pcl_ms/finish.h>
 #include <pcl_ms/process_group.h>
 #include <pcl_ms/types.h>
 
@@ -68,19 +69,26 @@ struct PreparedSlice {
 PreparedSlice preparePointsTogether(const PointView &part, std::uint64_t first_record,
                                     bool with_normals, ProcessGroup &group);
 
-/// What meshSlicesInBuckets gives process 0: all the points, joined in the
-/// prepared order, and their surface before finishing (as meshInBuckets
-/// gives it). The other processes get the statistics only.
+/// What meshSlicesInBuckets gives: on process 0, the finished surface in
+/// the prepared order's numbers and the points' records in the user's
+/// cloud (`points.user_index`; their positions too when the medial axis is
+/// asked for); on every process, the buckets' figures and times
+/// (`surface`, without triangles).
 struct SharedSurface {
   PreparedPoints points;
   BucketedSurface surface;
+  FinishedSurface finished;
+  double finish_seconds = 0;
 };
 
 /// Meshes in buckets the points of all processes' slices, each process
 /// meshing the buckets it owns (bucketOwner) and the seam zones whose first
-/// bucket it owns, with the points those need sent to it: no process holds
-/// all the points until process 0 receives them at the end. The same
-/// triangles as meshInBuckets on the joined points. Collective.
+/// bucket it owns, with the points those need sent to it, then finishes the
+/// surface with the triangles in runs over the processes
+/// (detail::finishInParts): no process holds all the points or all the
+/// triangles until process 0 receives the finished triangles at the end.
+/// The same surface as meshInBuckets then finishSurface on the joined
+/// points. Collective.
 SharedSurface meshSlicesInBuckets(const PreparedSlice &slice, const Parameters &parameters,
                                   const Deadline *deadline, ProcessGroup &group);
 
