@@ -3,6 +3,7 @@
 // pcl::MedialScaffoldReconstruction and saves the mesh, in the manner of
 // PCL's own command-line tools. On any failure it prints exactly one line,
 // "error: <reason>", on stderr and exits non-zero, so scripts can rely on it.
+#include "huge_page_heap.h"
 #include "reconstruct_cli.h"
 #include "tool_support.h"
 
@@ -135,5 +136,6 @@ int run(int argc, char **argv) {
 } // namespace
 
 int main(int argc, char **argv) {
+  pcl_ms_tools::restartWithHugePageHeap(argv);
   return pcl_ms_tools::runGuarded(run, argc, argv, pcl_ms_tools::kReconstructionFailure);
 }

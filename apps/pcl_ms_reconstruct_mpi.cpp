@@ -19,6 +19,7 @@
 // agreed on and every rank exits with the same code; a failure on one rank
 // alone (a unit's exception, the time limit) prints its line and aborts the
 // job, so no rank waits for it.
+#include "huge_page_heap.h"
 #include "mpi_bucket_exchange.h"
 #include "mpi_cloud_reader.h"
 #include "mpi_process_group.h"
@@ -613,6 +614,7 @@ int run(const Job &job, int argc, char **argv) {
 } // namespace
 
 int main(int argc, char **argv) {
+  pcl_ms_tools::restartWithHugePageHeap(argv);
 #ifdef __GLIBC__
   // Blocks of 1 MB and more (unit messages, per-bucket triangles) are
   // mapped and returned on free. Left to glibc's adaptive threshold they

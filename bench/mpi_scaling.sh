@@ -4,11 +4,12 @@
 # pcl_ms_reconstruct_mpi on 1, 2 and 4 ranks against pcl_ms_reconstruct with
 # 2 threads, on a uniform sampling of the bunny (bench_buckets' points:
 # seed 20241122 + size). Prints wall time, each rank's and the job's peak
-# resident memory (rank 0 first: the ranks read the binary PCD in parts and
-# mesh their own buckets and seam zones; rank 0 then finishes the whole
-# surface), and whether every mesh is byte-identical to the single-process
-# one. Not part of ctest: 10M points take about 25 minutes
-# on two cores. -work DIR keeps the cloud and each run's log there.
+# resident memory (rank 0 first: the ranks read the binary PCD in parts,
+# mesh their own buckets and seam zones and finish the surface in parts;
+# rank 0 receives the finished triangles to write them), and whether every
+# mesh is byte-identical to the single-process one. Not part of ctest: 10M
+# points take about 12 minutes on two cores. -work DIR keeps the cloud and
+# each run's log there.
 #
 # Usage: bench/mpi_scaling.sh [-build DIR] [-points N] [-ranks "1 2 4"]
 #                             [-bucket_points M] [-work DIR] [-mesh PATH]

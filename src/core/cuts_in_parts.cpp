@@ -95,7 +95,6 @@ CutPart cutInParts(const std::vector<Triangle> &mine, std::uint64_t first,
   for (std::size_t t = 0; t < count; ++t)
     if (!cut[t])
       left.push_back(mine[t]);
-  std::vector<std::uint8_t>().swap(cut);
   const std::vector<std::uint64_t> left_firsts = firstsOf(countsOf(left.size(), group));
   const std::uint64_t left_first = left_firsts[static_cast<std::size_t>(group.process())];
 
@@ -136,6 +135,13 @@ CutPart cutInParts(const std::vector<Triangle> &mine, std::uint64_t first,
   for (std::size_t t = 0; t < left.size(); ++t)
     if (!split_off[t])
       part.kept.push_back(left[t]);
+  // The places of what went: cut, or left and split off.
+  for (std::size_t t = 0, l = 0; t < count; ++t) {
+    if (cut[t])
+      part.dropped.push_back(t);
+    else if (split_off[l++])
+      part.dropped.push_back(t);
+  }
   const std::vector<VertexIndex> split_corners = cornersOf(left, split_off);
   std::vector<VertexIndex> touched;
   std::set_union(part.touched.begin(), part.touched.end(), split_corners.begin(),

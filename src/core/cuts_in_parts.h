@@ -27,6 +27,9 @@ struct CutPart {
   std::vector<VertexIndex> touched;
   /// On every process: the bow-ties' triangles that went, of the whole list.
   std::uint64_t split_off = 0;
+  /// The places in the process's run of the triangles that went (cut or
+  /// split off), ascending: what dropFromEdgesInParts() takes.
+  std::vector<std::size_t> dropped;
 };
 
 /// Collective. `mine` is this process's run of the list, from whole-list

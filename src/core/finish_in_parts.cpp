@@ -29,19 +29,26 @@ FinishedPart finishInParts(const std::vector<Triangle> &mine, std::uint64_t firs
   FinishedPart part;
   part.triangles = mine;
   part.first = first;
+  // One scan of the edges; fillings and cuts update it from then on (a
+  // crowded list is scanned again).
+  MeshEdgesPart edges = meshEdgesInParts(part.triangles, part.first, point_count, group);
   // Small holes filled, then every component oriented; returns the
   // triangles to cut where a twist is a fold or a crumple.
   const auto fillThenOrient = [&](int max_edges, const std::vector<VertexIndex> *around) {
-    MeshEdgesPart edges = meshEdgesInParts(part.triangles, part.first, point_count, group);
     HolesPart holes = fillHolesInParts(part.triangles, edges, home_points, home_scales, home_first,
                                        max_edges, rho, around, group);
     part.boundary_loops = std::move(holes.loops);
     part.holes_filled += holes.filled;
     if (holes.filled > 0) {
+      const std::size_t first_new = part.triangles.size();
       if (last)
         part.triangles.insert(part.triangles.end(), holes.filling.begin(), holes.filling.end());
-      edges = MeshEdgesPart(); // not held while the new ones are made
-      edges = meshEdgesInParts(part.triangles, part.first, point_count, group);
+      if (edges.crowded) {
+        edges = MeshEdgesPart(); // not held while the new ones are made
+        edges = meshEdgesInParts(part.triangles, part.first, point_count, group);
+      } else {
+        addTrianglesToEdgesInParts(edges, part.triangles, part.first, first_new, group);
+      }
     }
     ComponentsPart components = componentsInParts(part.triangles, part.first, edges, group);
     const CornerPoints corners =
@@ -63,6 +70,12 @@ FinishedPart finishInParts(const std::vector<Triangle> &mine, std::uint64_t firs
   for (int round = 0; round < max_untwist_rounds && totalOver(to_cut.size(), group) > 0; ++round) {
     const std::uint64_t before = totalOver(part.triangles.size(), group);
     CutPart cut = cutInParts(part.triangles, part.first, to_cut, group);
+    if (edges.crowded) {
+      edges = MeshEdgesPart(); // not held while the new ones are made
+      edges = meshEdgesInParts(cut.kept, cut.first, point_count, group);
+    } else {
+      dropFromEdgesInParts(edges, part.triangles, part.first, cut.dropped, group);
+    }
     part.triangles = std::move(cut.kept);
     part.first = cut.first;
     part.twist_triangles_removed += before - totalOver(part.triangles.size(), group);

@@ -57,7 +57,7 @@ TEST(CutsInParts, KeptTrianglesAndTouchedVerticesAreThoseOfOneProcessForAnySplit
         mine_to_cut.push_back(to_cut[i]);
       parts[p] = detail::cutInParts(mine, cuts[p], mine_to_cut, group);
     });
-    std::vector<Triangle> kept;
+    std::vector<Triangle> kept, kept_by_place;
     std::vector<bool> touched_in_parts(point_count, false);
     for (int p = 0; p < processes; ++p) {
       const detail::CutPart &part = parts[static_cast<std::size_t>(p)];
@@ -65,10 +65,20 @@ TEST(CutsInParts, KeptTrianglesAndTouchedVerticesAreThoseOfOneProcessForAnySplit
       EXPECT_EQ(part.split_off, split_off) << "process " << p;
       EXPECT_TRUE(std::is_sorted(part.touched.begin(), part.touched.end()));
       kept.insert(kept.end(), part.kept.begin(), part.kept.end());
+      // The places of what went leave exactly the kept triangles.
+      ASSERT_TRUE(std::is_sorted(part.dropped.begin(), part.dropped.end()));
+      for (std::size_t t = cuts[static_cast<std::size_t>(p)], d = 0;
+           t < cuts[static_cast<std::size_t>(p) + 1]; ++t) {
+        if (d < part.dropped.size() && part.dropped[d] + cuts[static_cast<std::size_t>(p)] == t)
+          ++d;
+        else
+          kept_by_place.push_back(triangles[t]);
+      }
       for (VertexIndex v : part.touched)
         touched_in_parts[v] = true;
     }
     EXPECT_EQ(kept, expected);
+    EXPECT_EQ(kept_by_place, expected);
     EXPECT_EQ(touched_in_parts, touched);
   }
 }
