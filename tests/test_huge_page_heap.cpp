@@ -35,11 +35,18 @@ protected:
   int starts_ = 0;
 };
 
-/// Whether this kernel gives transparent huge pages only where advised.
+/// Whether this kernel gives transparent huge pages only where advised,
+/// under a glibc that has the tunable: where the tools restart.
 bool hugePagesOnAdvice() {
+#if defined(__GLIBC__) && defined(__linux__)
+  if (!__GLIBC_PREREQ(2, 35))
+    return false;
   std::ifstream mode("/sys/kernel/mm/transparent_hugepage/enabled");
   std::string line;
   return std::getline(mode, line) && contains(line, "[madvise]");
+#else
+  return false;
+#endif
 }
 
 TEST_F(HugePageHeap, RestartsOnceInPlaceWithTheTunableAndTheSameArguments) {

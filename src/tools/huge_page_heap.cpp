@@ -2,14 +2,21 @@
 // A restart with glibc's malloc on transparent huge pages (huge_page_heap.h).
 #include "huge_page_heap.h"
 
-#include <cstdlib>
+#include <cstdlib> // and with glibc, <features.h>: __GLIBC__
+
+// __GLIBC_PREREQ exists only with glibc, so the test is nested.
+#if defined(__linux__) && defined(__GLIBC__)
+#if __GLIBC_PREREQ(2, 35)
+#define PCL_MS_HUGE_PAGE_HEAP 1
+#endif
+#endif
+
+#if defined(PCL_MS_HUGE_PAGE_HEAP)
+#include <unistd.h>
+
 #include <cstring>
 #include <fstream>
 #include <string>
-
-#if defined(__linux__)
-#include <unistd.h>
-#endif
 
 namespace pcl_ms_tools {
 namespace {
@@ -32,7 +39,6 @@ bool contains(const char *text, const char *part) {
 } // namespace
 
 void restartWithHugePageHeap(char **argv) {
-#if defined(__linux__) && defined(__GLIBC__) && __GLIBC_PREREQ(2, 35)
   if (std::getenv(kChoice) != nullptr || contains(std::getenv("GLIBC_TUNABLES"), kTunable) ||
       contains(std::getenv("LD_PRELOAD"), "vgpreload") || !hugePagesOnAdvice())
     return;
@@ -44,9 +50,16 @@ void restartWithHugePageHeap(char **argv) {
     return;
   execv("/proc/self/exe", argv);
   // Still here: the restart failed; go on as started, 4 kB pages.
-#else
-  (void)argv;
-#endif
 }
 
 } // namespace pcl_ms_tools
+
+#else
+
+namespace pcl_ms_tools {
+
+void restartWithHugePageHeap(char **) {}
+
+} // namespace pcl_ms_tools
+
+#endif
