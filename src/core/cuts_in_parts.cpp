@@ -132,9 +132,6 @@ CutPart cutInParts(const std::vector<Triangle> &mine, std::uint64_t first,
       split_off[t] |= going[t];
   }
 
-  for (std::size_t t = 0; t < left.size(); ++t)
-    if (!split_off[t])
-      part.kept.push_back(left[t]);
   // The places of what went: cut, or left and split off.
   for (std::size_t t = 0, l = 0; t < count; ++t) {
     if (cut[t])
@@ -143,6 +140,13 @@ CutPart cutInParts(const std::vector<Triangle> &mine, std::uint64_t first,
       part.dropped.push_back(t);
   }
   const std::vector<VertexIndex> split_corners = cornersOf(left, split_off);
+  // What stays, in place: no third copy of the run beside `mine` and `left`.
+  std::size_t kept = 0;
+  for (std::size_t t = 0; t < left.size(); ++t)
+    if (!split_off[t])
+      left[kept++] = left[t];
+  left.resize(kept);
+  part.kept = std::move(left);
   std::vector<VertexIndex> touched;
   std::set_union(part.touched.begin(), part.touched.end(), split_corners.begin(),
                  split_corners.end(), std::back_inserter(touched));

@@ -15,21 +15,22 @@ namespace pcl_ms {
 namespace detail {
 namespace {
 
-/// An edge of a triangle, sent to the edge's judge: the triangle's number
-/// times 4 plus the edge's place k in it (corners k and k + 1), so that the
-/// answer needs no key.
-struct EdgeUse {
+/// An edge's key with a number, ordered by key then number. The scan sends
+/// each edge to its judge with the number of its triangle times 4 plus the
+/// edge's place k in it (corners k and k + 1), so that the answer needs no
+/// key; elsewhere the number is a triangle's.
+struct KeyedEdge {
   EdgeKey key;
-  std::uint64_t triangle_edge;
-  bool operator<(const EdgeUse &other) const {
-    return key < other.key || (key == other.key && triangle_edge < other.triangle_edge);
+  std::uint64_t number;
+  bool operator<(const KeyedEdge &other) const {
+    return key < other.key || (key == other.key && number < other.number);
   }
 };
 
 /// The judge's answer to the holder of a triangle's edge: the triangle
 /// across it, or no_neighbour_in_parts for a boundary edge.
 struct EdgeVerdict {
-  std::uint64_t triangle_edge;
+  std::uint64_t triangle_edge; // as in KeyedEdge::number
   std::uint64_t across;
 };
 
@@ -40,15 +41,6 @@ struct EdgeVerdict {
 std::uint64_t roundsFor(std::size_t values, std::size_t per_round, ProcessGroup &group) {
   return maximumOver((values + per_round - 1) / per_round, group);
 }
-
-/// A new triangle's edge, as every process learns it.
-struct NewEdgeUse {
-  EdgeKey key;
-  std::uint64_t triangle;
-  bool operator<(const NewEdgeUse &other) const {
-    return key < other.key || (key == other.key && triangle < other.triangle);
-  }
-};
 
 /// A triangle's edge keys in ascending order.
 std::array<EdgeKey, 3> sortedKeys(const Triangle &t) {
@@ -67,7 +59,7 @@ bool openAt(const MeshEdgesPart &edges, EdgeKey key, std::uint64_t triangle) {
 }
 
 /// Boundary edges that open: (key, triangle), sorted.
-using OpenedEdges = std::vector<std::pair<EdgeKey, std::uint64_t>>;
+using OpenedEdges = std::vector<KeyedEdge>;
 
 /// The boundary of `edges` without the entries `goes(e)` marks, with
 /// `opened` (no key of which is on it), in key order; every triangle
@@ -79,10 +71,10 @@ void updateBoundary(MeshEdgesPart &edges, const OpenedEdges &opened, const Goes 
   std::vector<std::uint64_t> boundary_triangle;
   std::size_t o = 0;
   for (std::size_t e = 0; e <= edges.boundary.size(); ++e) {
-    for (; o < opened.size() && (e == edges.boundary.size() || opened[o].first < edges.boundary[e]);
+    for (; o < opened.size() && (e == edges.boundary.size() || opened[o].key < edges.boundary[e]);
          ++o) {
-      boundary.push_back(opened[o].first);
-      boundary_triangle.push_back(renumbered(opened[o].second));
+      boundary.push_back(opened[o].key);
+      boundary_triangle.push_back(renumbered(opened[o].number));
     }
     if (e < edges.boundary.size() && !goes(e)) {
       boundary.push_back(edges.boundary[e]);
@@ -124,11 +116,11 @@ MeshEdgesPart meshEdgesInParts(const std::vector<Triangle> &mine, std::uint64_t 
       ++counts[judgeOf(keyOf(t, k))][0];
   std::uint64_t incoming = 0;
   deliver(counts, group, [&](std::uint64_t count) { incoming += count; });
-  std::vector<EdgeUse> uses;
+  std::vector<KeyedEdge> uses;
   uses.reserve(static_cast<std::size_t>(incoming));
   const std::size_t triangles_per_round = records_per_round / 3;
   const std::uint64_t use_rounds = roundsFor(mine.size(), triangles_per_round, group);
-  std::vector<std::vector<EdgeUse>> uses_out(processes);
+  std::vector<std::vector<KeyedEdge>> uses_out(processes);
   for (std::uint64_t round = 0; round < use_rounds; ++round) {
     const std::size_t begin = std::min<std::size_t>(mine.size(), round * triangles_per_round);
     const std::size_t end = std::min<std::size_t>(mine.size(), begin + triangles_per_round);
@@ -137,14 +129,15 @@ MeshEdgesPart meshEdgesInParts(const std::vector<Triangle> &mine, std::uint64_t 
         const EdgeKey key = keyOf(t, k);
         uses_out[judgeOf(key)].push_back({key, 4 * (first + t) + k});
       }
-    deliver(uses_out, group, [&](const EdgeUse &use) { uses.push_back(use); });
+    deliver(uses_out, group, [&](const KeyedEdge &use) { uses.push_back(use); });
   }
-  parallelSort(uses.begin(), uses.end(), std::less<EdgeUse>());
+  parallelSort(uses.begin(), uses.end(), std::less<KeyedEdge>());
 
   // Judged in key order, a round's worth of edges at a time (an edge's
   // triangles are judged in the round where the first of them falls).
   MeshEdgesPart part;
   part.neighbours.assign(3 * mine.size(), no_neighbour_in_parts);
+  std::vector<KeyedEdge> boundary; // (key, triangle)
   const auto holderOf = [&](std::uint64_t triangle_edge) {
     return runHolding(firsts, triangle_edge / 4);
   };
@@ -152,8 +145,7 @@ MeshEdgesPart meshEdgesInParts(const std::vector<Triangle> &mine, std::uint64_t 
     const std::size_t t = static_cast<std::size_t>(verdict.triangle_edge / 4 - first);
     const EdgeKey key = keyOf(t, static_cast<std::size_t>(verdict.triangle_edge % 4));
     if (verdict.across == no_neighbour_in_parts) {
-      part.boundary.push_back(key);
-      part.boundary_triangle.push_back(first + t);
+      boundary.push_back({key, first + t});
     } else {
       part.neighbours[3 * t + slotOf(mine[t], key)] = verdict.across;
     }
@@ -169,10 +161,9 @@ MeshEdgesPart meshEdgesInParts(const std::vector<Triangle> &mine, std::uint64_t 
       while (j < uses.size() && uses[j].key == uses[i].key)
         ++j;
       if (j - i == 1) {
-        verdicts_out[holderOf(uses[i].triangle_edge)].push_back(
-            {uses[i].triangle_edge, no_neighbour_in_parts});
+        verdicts_out[holderOf(uses[i].number)].push_back({uses[i].number, no_neighbour_in_parts});
       } else if (j - i == 2) {
-        const std::uint64_t t = uses[i].triangle_edge, u = uses[i + 1].triangle_edge;
+        const std::uint64_t t = uses[i].number, u = uses[i + 1].number;
         verdicts_out[holderOf(t)].push_back({t, u / 4});
         verdicts_out[holderOf(u)].push_back({u, t / 4});
       } else {
@@ -182,22 +173,16 @@ MeshEdgesPart meshEdgesInParts(const std::vector<Triangle> &mine, std::uint64_t 
     }
     deliver(verdicts_out, group, take);
   }
-  std::vector<EdgeUse>().swap(uses);
+  std::vector<KeyedEdge>().swap(uses);
   // The rounds mix the judges' answers; a boundary edge has one triangle,
   // so its key alone orders it.
-  std::vector<std::size_t> order(part.boundary.size());
-  for (std::size_t b = 0; b < order.size(); ++b)
-    order[b] = b;
-  std::sort(order.begin(), order.end(),
-            [&](std::size_t a, std::size_t b) { return part.boundary[a] < part.boundary[b]; });
-  std::vector<EdgeKey> boundary(order.size());
-  std::vector<std::uint64_t> boundary_triangle(order.size());
-  for (std::size_t b = 0; b < order.size(); ++b) {
-    boundary[b] = part.boundary[order[b]];
-    boundary_triangle[b] = part.boundary_triangle[order[b]];
+  std::sort(boundary.begin(), boundary.end());
+  part.boundary.reserve(boundary.size());
+  part.boundary_triangle.reserve(boundary.size());
+  for (const KeyedEdge &edge : boundary) {
+    part.boundary.push_back(edge.key);
+    part.boundary_triangle.push_back(edge.number);
   }
-  part.boundary = std::move(boundary);
-  part.boundary_triangle = std::move(boundary_triangle);
   packSlots(part.neighbours, no_neighbour_in_parts);
   part.crowded = totalOver(crowded ? 1 : 0, group) > 0;
   return part;
@@ -211,13 +196,13 @@ void addTrianglesToEdgesInParts(MeshEdgesPart &edges, const std::vector<Triangle
     return triangle >= first && triangle < first + mine.size();
   };
   // Every process gets every new edge, and every boundary edge they use.
-  std::vector<NewEdgeUse> own_uses;
+  std::vector<KeyedEdge> own_uses;
   for (std::size_t t = first_new; t < mine.size(); ++t)
     for (int k = 0; k < 3; ++k)
       own_uses.push_back({edgeKey(mine[t][k], mine[t][(k + 1) % 3]), first + t});
-  std::vector<NewEdgeUse> uses = valuesOf<NewEdgeUse>(group.gatherAll(bytesOf(own_uses)));
+  std::vector<KeyedEdge> uses = valuesOf<KeyedEdge>(group.gatherAll(bytesOf(own_uses)));
   std::sort(uses.begin(), uses.end());
-  std::vector<NewEdgeUse> own_closed; // (boundary key, its triangle)
+  std::vector<KeyedEdge> own_closed; // (boundary key, its triangle)
   for (std::size_t i = 0; i < uses.size(); ++i)
     if (i == 0 || uses[i].key != uses[i - 1].key) {
       const auto at = std::lower_bound(edges.boundary.begin(), edges.boundary.end(), uses[i].key);
@@ -226,12 +211,12 @@ void addTrianglesToEdgesInParts(MeshEdgesPart &edges, const std::vector<Triangle
             {uses[i].key,
              edges.boundary_triangle[static_cast<std::size_t>(at - edges.boundary.begin())]});
     }
-  std::vector<NewEdgeUse> closed = valuesOf<NewEdgeUse>(group.gatherAll(bytesOf(own_closed)));
+  std::vector<KeyedEdge> closed = valuesOf<KeyedEdge>(group.gatherAll(bytesOf(own_closed)));
   std::sort(closed.begin(), closed.end());
 
   // Each edge decided alike on every process; each keeps what is its own.
   edges.neighbours.resize(3 * mine.size(), no_neighbour_in_parts);
-  std::vector<std::pair<std::uint64_t, NewEdgeUse>> links; // (triangle, {key, across})
+  std::vector<std::pair<std::uint64_t, KeyedEdge>> links; // (triangle, {key, across})
   OpenedEdges opened;
   const auto link = [&](std::uint64_t t, EdgeKey key, std::uint64_t u) {
     if (isMine(t))
@@ -242,17 +227,17 @@ void addTrianglesToEdgesInParts(MeshEdgesPart &edges, const std::vector<Triangle
     while (j < uses.size() && uses[j].key == uses[i].key)
       ++j;
     const EdgeKey key = uses[i].key;
-    const auto at = std::lower_bound(closed.begin(), closed.end(), NewEdgeUse{key, 0});
+    const auto at = std::lower_bound(closed.begin(), closed.end(), KeyedEdge{key, 0});
     const bool was_boundary = at != closed.end() && at->key == key;
     const std::size_t count = j - i + (was_boundary ? 1 : 0);
-    const std::uint64_t one = was_boundary ? at->triangle : uses[i].triangle;
-    const std::uint64_t other = uses[j - 1].triangle;
+    const std::uint64_t one = was_boundary ? at->number : uses[i].number;
+    const std::uint64_t other = uses[j - 1].number;
     if (count == 2) {
       link(one, key, other);
       link(other, key, one);
     } else if (count == 1) {
       if (isMine(one))
-        opened.emplace_back(key, one);
+        opened.push_back({key, one});
     } else {
       edges.crowded = true; // three or more: not manifold, no neighbours
     }
@@ -279,24 +264,23 @@ void addTrianglesToEdgesInParts(MeshEdgesPart &edges, const std::vector<Triangle
                                        [&](const auto &l) { return l.second.key == keys[k]; });
       const bool was_open = openAt(edges, keys[k], first + t);
       if (gained != links.begin() + static_cast<std::ptrdiff_t>(j))
-        by_key[k] = gained->second.triangle;
+        by_key[k] = gained->second.number;
       else if (t < first_new && !was_open)
         by_key[k] = slots[held++];
       else
         by_key[k] = no_neighbour_in_parts;
     }
-    for (std::size_t k = 0; k < 3; ++k)
-      slots[k] = by_key[k];
+    std::copy(by_key.begin(), by_key.end(), slots);
+    packSlotsOf(slots, no_neighbour_in_parts); // the others' slots are as they were
     i = j;
   }
-  packSlots(edges.neighbours, no_neighbour_in_parts);
   // The boundary without the closed edges, with the opened ones, in key order.
   std::sort(opened.begin(), opened.end());
   updateBoundary(
       edges, opened,
       [&](std::size_t e) {
         const auto at =
-            std::lower_bound(closed.begin(), closed.end(), NewEdgeUse{edges.boundary[e], 0});
+            std::lower_bound(closed.begin(), closed.end(), KeyedEdge{edges.boundary[e], 0});
         return at != closed.end() && at->key == edges.boundary[e];
       },
       [](std::uint64_t t) { return t; });
@@ -346,7 +330,7 @@ void dropFromEdgesInParts(MeshEdgesPart &edges, const std::vector<Triangle> &min
   deliver(openings, group, [&](const Opening &opening) {
     std::uint64_t *slots = &edges.neighbours[3 * static_cast<std::size_t>(opening.stays - first)];
     std::fill(std::remove(slots, slots + 3, opening.went), slots + 3, no_neighbour_in_parts);
-    opened.emplace_back(opening.key, opening.stays);
+    opened.push_back({opening.key, opening.stays});
   });
 
   // The numbers of the list left: each moves down by those gone before it.

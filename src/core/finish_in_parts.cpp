@@ -14,6 +14,7 @@
 #include "sides_in_parts.h"
 #include "twists_in_parts.h"
 
+#include <optional>
 #include <utility>
 
 namespace pcl_ms {
@@ -32,6 +33,11 @@ FinishedPart finishInParts(const std::vector<Triangle> &mine, std::uint64_t firs
   // One scan of the edges; fillings and cuts update it from then on (a
   // crowded list is scanned again).
   MeshEdgesPart edges = meshEdgesInParts(part.triangles, part.first, point_count, group);
+  const auto scanAgain = [&](const std::vector<Triangle> &triangles, std::uint64_t from) {
+    edges = MeshEdgesPart(); // not held while the new ones are made
+    edges = meshEdgesInParts(triangles, from, point_count, group);
+  };
+  std::optional<CornerPoints> corners;
   // Small holes filled, then every component oriented; returns the
   // triangles to cut where a twist is a fold or a crumple.
   const auto fillThenOrient = [&](int max_edges, const std::vector<VertexIndex> *around) {
@@ -39,29 +45,31 @@ FinishedPart finishInParts(const std::vector<Triangle> &mine, std::uint64_t firs
                                        max_edges, rho, around, group);
     part.boundary_loops = std::move(holes.loops);
     part.holes_filled += holes.filled;
+    const std::size_t first_new = part.triangles.size();
     if (holes.filled > 0) {
-      const std::size_t first_new = part.triangles.size();
       if (last)
         part.triangles.insert(part.triangles.end(), holes.filling.begin(), holes.filling.end());
-      if (edges.crowded) {
-        edges = MeshEdgesPart(); // not held while the new ones are made
-        edges = meshEdgesInParts(part.triangles, part.first, point_count, group);
-      } else {
+      if (edges.crowded)
+        scanAgain(part.triangles, part.first);
+      else
         addTrianglesToEdgesInParts(edges, part.triangles, part.first, first_new, group);
-      }
     }
     ComponentsPart components = componentsInParts(part.triangles, part.first, edges, group);
-    const CornerPoints corners =
-        cornerPointsFromHomes(part.triangles, home_points, home_first, group);
+    // After a cut, only the filling can bring corners that are not held yet.
+    if (corners)
+      addCornerPointsFromHomes(*corners, part.triangles, first_new, home_points, home_first, group);
+    else
+      corners = cornerPointsFromHomes(part.triangles, home_points, home_first, group);
     const std::vector<std::uint8_t> side_turns =
-        sideTurnsInParts(part.triangles, part.first, edges, components, corners, viewpoint, group);
+        sideTurnsInParts(part.triangles, part.first, edges, components, *corners, viewpoint, group);
     const TwistsPart twists =
-        twistForestInParts(part.triangles, part.first, edges, components, corners, group);
+        twistForestInParts(part.triangles, part.first, edges, components, *corners, group);
     for (std::size_t t = 0; t < part.triangles.size(); ++t)
       if (side_turns[t] ^ twists.flipped[t])
         std::swap(part.triangles[t][1], part.triangles[t][2]);
-    std::vector<std::uint64_t> cuts = conflictCutsInParts(
-        part.triangles, part.first, edges, components, corners, twists.conflicts, viewpoint, group);
+    std::vector<std::uint64_t> cuts =
+        conflictCutsInParts(part.triangles, part.first, edges, components, *corners,
+                            twists.conflicts, viewpoint, group);
     part.component = std::move(components.component);
     part.orientable = std::move(components.orientable);
     return cuts;
@@ -70,12 +78,10 @@ FinishedPart finishInParts(const std::vector<Triangle> &mine, std::uint64_t firs
   for (int round = 0; round < max_untwist_rounds && totalOver(to_cut.size(), group) > 0; ++round) {
     const std::uint64_t before = totalOver(part.triangles.size(), group);
     CutPart cut = cutInParts(part.triangles, part.first, to_cut, group);
-    if (edges.crowded) {
-      edges = MeshEdgesPart(); // not held while the new ones are made
-      edges = meshEdgesInParts(cut.kept, cut.first, point_count, group);
-    } else {
+    if (edges.crowded)
+      scanAgain(cut.kept, cut.first);
+    else
       dropFromEdgesInParts(edges, part.triangles, part.first, cut.dropped, group);
-    }
     part.triangles = std::move(cut.kept);
     part.first = cut.first;
     part.twist_triangles_removed += before - totalOver(part.triangles.size(), group);

@@ -45,17 +45,19 @@ inline std::size_t slotOf(const Triangle &t, EdgeKey key) {
   return below;
 }
 
-/// Packs each triangle's three slots (slots[3 t + k]): the neighbours
-/// first, in the order they stand, then `none`.
+/// Packs one triangle's three slots `own`: the neighbours first, in the
+/// order they stand, then `none`.
+template <typename Slot> void packSlotsOf(Slot *own, Slot none) {
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < 3; ++k)
+    if (own[k] != none)
+      own[kept++] = own[k];
+  std::fill(own + kept, own + 3, none);
+}
+
+/// Packs each triangle's three slots (slots[3 t + k]) as packSlotsOf does.
 template <typename Slot> void packSlots(std::vector<Slot> &slots, Slot none) {
-  forEachIndex(slots.size() / 3, [&](std::size_t t) {
-    Slot *own = &slots[3 * t];
-    std::size_t kept = 0;
-    for (std::size_t k = 0; k < 3; ++k)
-      if (own[k] != none)
-        own[kept++] = own[k];
-    std::fill(own + kept, own + 3, none);
-  });
+  forEachIndex(slots.size() / 3, [&](std::size_t t) { packSlotsOf(&slots[3 * t], none); });
 }
 
 /// The edge that two neighbouring triangles share, as its key.

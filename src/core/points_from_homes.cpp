@@ -15,34 +15,82 @@ const Eigen::Vector3d &CornerPoints::of(VertexIndex v) const {
                                          vertices.begin())];
 }
 
+namespace {
+
+/// The corners of mine[from...], ascending, each once.
+std::vector<VertexIndex> cornersOf(const std::vector<Triangle> &mine, std::size_t from) {
+  std::vector<VertexIndex> vertices;
+  vertices.reserve(3 * (mine.size() - from));
+  for (std::size_t t = from; t < mine.size(); ++t)
+    vertices.insert(vertices.end(), mine[t].begin(), mine[t].end());
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  return vertices;
+}
+
+/// Collective. The positions of `vertices` (ascending) from their homes;
+/// `firsts` is runFirsts() of the home slices.
+std::vector<Eigen::Vector3d> pointsFromHomes(const std::vector<VertexIndex> &vertices,
+                                             const std::vector<std::uint64_t> &firsts,
+                                             const std::vector<Eigen::Vector3d> &home,
+                                             std::uint64_t home_first, ProcessGroup &group) {
+  const bool beyond = !vertices.empty() && vertices.back() >= firsts.back();
+  if (totalOver(beyond ? 1 : 0, group) > 0)
+    throw std::invalid_argument("cornerPointsFromHomes: a triangle has a corner beyond the points");
+  const std::vector<std::array<double, 3>> values = valuesFromHomes<std::array<double, 3>>(
+      vertices, firsts, home_first,
+      [&](std::size_t i) {
+        return std::array<double, 3>{home[i].x(), home[i].y(), home[i].z()};
+      },
+      group);
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(values.size());
+  for (const std::array<double, 3> &value : values)
+    points.emplace_back(value[0], value[1], value[2]);
+  return points;
+}
+
+} // namespace
+
 CornerPoints cornerPointsFromHomes(const std::vector<Triangle> &mine,
                                    const std::vector<Eigen::Vector3d> &home,
                                    std::uint64_t home_first, ProcessGroup &group) {
   const std::vector<std::uint64_t> firsts =
       runFirsts(home.size(), home_first, group, "cornerPointsFromHomes (points)");
-  const std::uint64_t point_count = firsts.back();
-
   CornerPoints corners;
-  corners.vertices.reserve(3 * mine.size());
-  for (const Triangle &t : mine)
-    corners.vertices.insert(corners.vertices.end(), t.begin(), t.end());
-  std::sort(corners.vertices.begin(), corners.vertices.end());
-  corners.vertices.erase(std::unique(corners.vertices.begin(), corners.vertices.end()),
-                         corners.vertices.end());
-  const bool beyond = !corners.vertices.empty() && corners.vertices.back() >= point_count;
-  if (totalOver(beyond ? 1 : 0, group) > 0)
-    throw std::invalid_argument("cornerPointsFromHomes: a triangle has a corner beyond the points");
-
-  const std::vector<std::array<double, 3>> points = valuesFromHomes<std::array<double, 3>>(
-      corners.vertices, firsts, home_first,
-      [&](std::size_t i) {
-        return std::array<double, 3>{home[i].x(), home[i].y(), home[i].z()};
-      },
-      group);
-  corners.points.reserve(points.size());
-  for (const std::array<double, 3> &point : points)
-    corners.points.emplace_back(point[0], point[1], point[2]);
+  corners.vertices = cornersOf(mine, 0);
+  corners.points = pointsFromHomes(corners.vertices, firsts, home, home_first, group);
   return corners;
+}
+
+void addCornerPointsFromHomes(CornerPoints &corners, const std::vector<Triangle> &mine,
+                              std::size_t first_new, const std::vector<Eigen::Vector3d> &home,
+                              std::uint64_t home_first, ProcessGroup &group) {
+  const std::vector<std::uint64_t> firsts =
+      runFirsts(home.size(), home_first, group, "cornerPointsFromHomes (points)");
+  if (totalOver(first_new > mine.size() ? 1 : 0, group) > 0)
+    throw std::invalid_argument("addCornerPointsFromHomes: no such triangles");
+  std::vector<VertexIndex> missing;
+  for (VertexIndex v : cornersOf(mine, first_new))
+    if (!std::binary_search(corners.vertices.begin(), corners.vertices.end(), v))
+      missing.push_back(v);
+  const std::vector<Eigen::Vector3d> found =
+      pointsFromHomes(missing, firsts, home, home_first, group);
+  if (missing.empty())
+    return;
+  CornerPoints merged;
+  merged.vertices.reserve(corners.vertices.size() + missing.size());
+  merged.points.reserve(merged.vertices.capacity());
+  for (std::size_t i = 0, j = 0; i < corners.vertices.size() || j < missing.size();) {
+    if (j == missing.size() || (i < corners.vertices.size() && corners.vertices[i] < missing[j])) {
+      merged.vertices.push_back(corners.vertices[i]);
+      merged.points.push_back(corners.points[i++]);
+    } else {
+      merged.vertices.push_back(missing[j]);
+      merged.points.push_back(found[j++]);
+    }
+  }
+  corners = std::move(merged);
 }
 
 } // namespace detail

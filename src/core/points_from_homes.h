@@ -18,7 +18,8 @@
 namespace pcl_ms {
 namespace detail {
 
-/// The corners of a run of triangles and their positions.
+/// The corners of a run of triangles and their positions (perhaps with
+/// those of triangles that have left the run: addCornerPointsFromHomes).
 struct CornerPoints {
   std::vector<VertexIndex> vertices; // ascending, each once
   std::vector<Eigen::Vector3d> points;
@@ -67,6 +68,16 @@ valuesFromHomes(const std::vector<VertexIndex> &vertices, const std::vector<std:
 CornerPoints cornerPointsFromHomes(const std::vector<Triangle> &mine,
                                    const std::vector<Eigen::Vector3d> &home,
                                    std::uint64_t home_first, ProcessGroup &group);
+
+/// Collective. Brings `corners` up to date for `mine`, whose triangles
+/// before `first_new` have their corners in it already (kept triangles of
+/// the run it was made for): only the new triangles' corners it lacks are
+/// fetched. Corners of triangles gone may stay: `corners` may hold more
+/// than the run's corners. Throws std::invalid_argument on every process
+/// as cornerPointsFromHomes does, or for first_new beyond mine.size().
+void addCornerPointsFromHomes(CornerPoints &corners, const std::vector<Triangle> &mine,
+                              std::size_t first_new, const std::vector<Eigen::Vector3d> &home,
+                              std::uint64_t home_first, ProcessGroup &group);
 
 } // namespace detail
 } // namespace pcl_ms

@@ -125,7 +125,7 @@ void expectSharesOfTheUpdatedScan(const std::vector<Triangle> &before,
   pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
     const auto p = static_cast<std::size_t>(group.process());
     std::vector<Triangle> mine = pcl_ms_test::sliceOf(before, cuts[p], cuts_before[p + 1]);
-    parts[p] = detail::meshEdgesInParts(mine, cuts[p], vertexCount(), group, 300);
+    parts[p] = detail::meshEdgesInParts(mine, cuts[p], vertexCount(), group);
     const std::size_t first_new = mine.size();
     if (p + 1 == parts.size())
       mine.insert(mine.end(), added.begin(), added.end());
@@ -574,6 +574,63 @@ TEST(SidesInParts, PointSlicesThatDoNotFollowEachOtherOrCornersBeyondThemFailOnE
     });
     EXPECT_EQ(failed, std::vector<int>({1, 1})) << second_first << " " << second_count;
   }
+}
+
+TEST(SidesInParts, CornersAddedAfterACutAreEveryCornerOfTheNewRun) {
+  // Each process's run loses every 7th triangle (a cut), then the last one
+  // gets triangles of the others' runs (a filling), whose corners it lacks.
+  const std::vector<Triangle> triangles = holedBunnyPatch();
+  const std::vector<Eigen::Vector3d> &points = pcl_ms_test::bunnyReference().vertices;
+  const std::size_t n = triangles.size(), m = points.size();
+  const std::vector<std::size_t> cuts = {0, n / 5, n / 2, n};
+  const std::vector<std::size_t> homes = {0, m / 2, m / 2 + 10, m}; // uneven slices
+  std::vector<Triangle> added;
+  for (std::size_t t = 3; t < n / 2; t += 97)
+    added.push_back(triangles[t]);
+  pcl_ms_test::onThreadProcesses(3, [&](ProcessGroup &group) {
+    const auto p = static_cast<std::size_t>(group.process());
+    const std::vector<Eigen::Vector3d> home(points.begin() + static_cast<std::ptrdiff_t>(homes[p]),
+                                            points.begin() +
+                                                static_cast<std::ptrdiff_t>(homes[p + 1]));
+    const std::vector<Triangle> before = pcl_ms_test::sliceOf(triangles, cuts[p], cuts[p + 1]);
+    detail::CornerPoints corners = detail::cornerPointsFromHomes(before, home, homes[p], group);
+    const std::vector<VertexIndex> corners_before = corners.vertices;
+    std::vector<Triangle> mine;
+    for (std::size_t t = 0; t < before.size(); ++t)
+      if (t % 7 != 0)
+        mine.push_back(before[t]);
+    const std::size_t first_new = mine.size();
+    if (p == 2)
+      mine.insert(mine.end(), added.begin(), added.end());
+    detail::addCornerPointsFromHomes(corners, mine, first_new, home, homes[p], group);
+
+    std::vector<VertexIndex> expected = corners_before;
+    for (const Triangle &t : mine)
+      expected.insert(expected.end(), t.begin(), t.end());
+    std::sort(expected.begin(), expected.end());
+    expected.erase(std::unique(expected.begin(), expected.end()), expected.end());
+    EXPECT_EQ(expected, corners.vertices) << "process " << p;
+    // EXPECT, not ASSERT: a process that left early would leave the others
+    // waiting in the last collective.
+    EXPECT_EQ(corners.vertices.size(), corners.points.size());
+    std::size_t wrong = 0;
+    for (std::size_t i = 0; i < std::min(corners.vertices.size(), corners.points.size()); ++i)
+      wrong += points[corners.vertices[i]] != corners.points[i];
+    EXPECT_EQ(0u, wrong) << "process " << p;
+    if (p == 2) {
+      EXPECT_GT(corners.vertices.size(), corners_before.size()); // the filling brought some
+    }
+
+    // Triangles that are not there fail on every process.
+    bool failed = false;
+    try {
+      detail::addCornerPointsFromHomes(corners, mine, p == 1 ? mine.size() + 1 : mine.size(), home,
+                                       homes[p], group);
+    } catch (const std::invalid_argument &) {
+      failed = true;
+    }
+    EXPECT_TRUE(failed) << "process " << p;
+  });
 }
 
 namespace {
