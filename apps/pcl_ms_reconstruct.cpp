@@ -129,7 +129,7 @@ int run(int argc, char **argv) {
       code != kSuccess)
     return fail(code, error);
   if (verbose)
-    pcl_ms_tools::printReconstructReport(result, load_ms, save_ms);
+    pcl_ms_tools::printReconstructReport(result, load_ms, save_ms, result.triangles.size());
   return kSuccess;
 }
 

@@ -5,8 +5,9 @@
 // The ranks read their own byte ranges of a binary PCD or PLY, prepare them
 // together (pcl_ms::preparePointsTogether), mesh them by owner and finish
 // the surface with the triangles in runs over the ranks
-// (pcl_ms::reconstructSlices): no rank holds the cloud or the surface until
-// rank 0 receives the finished triangles to write. A file rank 0 reads
+// (pcl_ms::reconstructSlices): no rank holds the cloud or the surface; into
+// a PLY, rank 0 writes the runs as the ranks send them, a piece at a time
+// (else it receives the finished triangles to write). A file rank 0 reads
 // whole (other formats) is meshed by a unit farm: rank 0 prepares it,
 // builds the bucket tree and hands each bucket and seam zone as a task to
 // a free rank (pcl_ms_mpi::MpiUnitFarm), meshing one itself meanwhile; the
@@ -47,6 +48,7 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -283,15 +285,17 @@ pcl_ms::Result meshPoints(const Job &job, pcl::PointCloud<PointT> &&points,
 }
 
 /// Every rank meshes the prepared slices with the others
-/// (pcl_ms::reconstructSlices: buckets by owner); rank 0 gets the result.
+/// (pcl_ms::reconstructSlices: buckets by owner); rank 0 gets the result,
+/// and, given `runs`, every rank its run of a bucketed surface.
 /// An unusable cloud fails alike on every rank, or on rank 0 alone where it
 /// alone works (one piece, the finishing): the status says so, `error`
 /// why. A failure on one rank while the others wait (the time limit, an
 /// unexpected error) aborts the job.
 int meshSlices(const Job &job, pcl_ms::PreparedSlice &&slice, const pcl_ms::Parameters &parameters,
-               pcl_ms_mpi::MpiProcessGroup &group, pcl_ms::Result &result, std::string &error) {
+               pcl_ms_mpi::MpiProcessGroup &group, pcl_ms::FinishedRun *runs,
+               pcl_ms::Result &result, std::string &error) {
   try {
-    result = pcl_ms::reconstructSlices(std::move(slice), parameters, group);
+    result = pcl_ms::reconstructSlices(std::move(slice), parameters, group, runs);
     return kSuccess;
   } catch (const pcl_ms::TimeLimitExceeded &late) {
     abortJob(job, kReconstructionFailure, std::string("reconstruction failed: ") + late.what());
@@ -332,6 +336,40 @@ int prepareParts(const Job &job, CloudPart<PointT> &&part, const pcl_ms::Paramet
     return kSuccess;
   return job.rank == 0 ? fail(kReconstructionFailure, "reconstruction failed: " + error)
                        : kReconstructionFailure;
+}
+
+/// Rank 0 writes the surface left in runs (writePlyFromInput's bytes): the
+/// others send theirs a piece at a time, in rank order, so that no rank
+/// holds more than its run and a piece. Rank 0 takes every piece even after
+/// a failure, so that no rank waits. Collective; rank 0's status.
+int writeRunsAsPly(const Job &job, const std::string &output, const std::string &input,
+                   const pcl_ms_mpi::BinaryCloudLayout &layout, const pcl_ms::FinishedRun &run,
+                   std::string &error) {
+  constexpr std::size_t piece = std::size_t(1) << 20; // triangles (12 MB)
+  std::uint64_t mine = run.triangles.size();
+  std::vector<std::uint64_t> counts(static_cast<std::size_t>(job.ranks), 0);
+  MPI_Gather(&mine, 1, MPI_UINT64_T, counts.data(), 1, MPI_UINT64_T, 0, job.communicator);
+  if (job.rank != 0) {
+    for (std::size_t begin = 0; begin < run.triangles.size(); begin += piece)
+      pcl_ms_mpi::sendBytes(run.triangles.data() + begin,
+                            std::min(piece, run.triangles.size() - begin) *
+                                sizeof(pcl_ms::Triangle),
+                            0, job.communicator);
+    return kSuccess;
+  }
+  pcl_ms_mpi::PlyFromInputWriter writer;
+  writer.open(output, input, layout, run.total);
+  writer.add(run.triangles.data(), run.triangles.size());
+  std::vector<pcl_ms::Triangle> arrived;
+  for (int r = 1; r < job.ranks; ++r)
+    for (std::uint64_t left = counts[static_cast<std::size_t>(r)]; left > 0;) {
+      arrived.resize(static_cast<std::size_t>(std::min<std::uint64_t>(piece, left)));
+      pcl_ms_mpi::receiveBytes(arrived.data(), arrived.size() * sizeof(pcl_ms::Triangle), r,
+                               job.communicator);
+      writer.add(arrived.data(), arrived.size());
+      left -= arrived.size();
+    }
+  return writer.close(error) ? kSuccess : pcl_ms_tools::kIoFailure;
 }
 
 /// How the input reaches the ranks; rank 0 decides, every rank gets it.
@@ -427,6 +465,13 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
     std::fflush(stdout);                                // the progress lines go to stderr
     parameters.progress = pcl_ms_tools::ProgressLine(); // rank 0's own units
   }
+  // A binary PCD or PLY of x y z only, all finite, into a PLY: the vertices
+  // go from the input to the output a block at a time, so rank 0 never
+  // holds the cloud (the same bytes as PCL's writer); a bucketed surface
+  // stays in runs on the ranks until it is written.
+  const bool streamed = input.in_parts && input.layout.xyz_only && read.all_finite &&
+                        input.layout.height == 1 && pcl_ms::fileExtension(options.output) == ".ply";
+  pcl_ms::FinishedRun run;
   const auto start = std::chrono::steady_clock::now();
   const auto secondsSinceStart = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -438,7 +483,8 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
   if (slice) {
     // Every rank meshes the buckets and zones it owns (buckets by owner).
     pcl_ms_mpi::MpiProcessGroup group(job.communicator);
-    status = meshSlices(job, std::move(*slice), parameters, group, result, error);
+    status = meshSlices(job, std::move(*slice), parameters, group, streamed ? &run : nullptr,
+                        result, error);
     slice.reset();
     result.timings.prepare = prepare_seconds;
     result.timings.total += prepare_seconds;
@@ -459,46 +505,59 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
     bytes_received = exchange.bytesReceived();
   }
   const double reconstruct_seconds = secondsSinceStart();
+  const std::size_t triangle_count =
+      run.used ? static_cast<std::size_t>(run.total) : result.triangles.size();
   if (verbose && status == kSuccess) {
     print_info("[done, ");
     print_value("%.1f", reconstruct_seconds * 1e3);
     print_info(" ms : ");
-    print_value("%zu", result.triangles.size());
+    print_value("%zu", triangle_count);
     print_info(" triangles]\n");
   } else if (verbose) {
     print_info("[failed]\n");
   }
 
-  // Rank 0 writes. A binary PCD or PLY of x y z only, all finite, into a PLY: the
-  // vertices go from the input to the output a block at a time, so rank 0
-  // never holds the cloud (the same bytes as PCL's writer). Otherwise it
-  // loads the file now, after the meshing has freed the points.
+  // Rank 0 writes: streamed (see above; with the ranks sending their runs),
+  // or else it loads the file now, after the meshing has freed the points.
   double save_ms = 0;
-  if (on_rank_zero && status == kSuccess) {
-    const bool streamed = input.in_parts && input.layout.xyz_only && read.all_finite &&
-                          input.layout.height == 1 &&
-                          pcl_ms::fileExtension(options.output) == ".ply";
+  const auto saveStreamed = [&](const std::function<int()> &write) {
+    if (verbose) {
+      pcl::console::print_highlight("Saving ");
+      print_value("%s ", options.output.c_str());
+    }
+    const auto save_start = std::chrono::steady_clock::now();
+    status = write();
+    save_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - save_start)
+            .count();
+    if (verbose) {
+      if (status == kSuccess) {
+        print_info("[done, ");
+        print_value("%.1f", save_ms);
+        print_info(" ms]\n");
+      } else {
+        print_info("[failed]\n");
+      }
+    }
+  };
+  if (run.used) {
+    int all_meshed = status == kSuccess;
+    MPI_Allreduce(MPI_IN_PLACE, &all_meshed, 1, MPI_INT, MPI_MIN, job.communicator);
+    if (all_meshed)
+      saveStreamed([&] {
+        return writeRunsAsPly(job, options.output, options.input, input.layout, run, error);
+      });
+    else if (status == kSuccess)
+      status = kReconstructionFailure; // another rank's failure, which it printed
+    run = pcl_ms::FinishedRun();
+  } else if (on_rank_zero && status == kSuccess) {
     if (streamed) {
-      if (verbose) {
-        pcl::console::print_highlight("Saving ");
-        print_value("%s ", options.output.c_str());
-      }
-      const auto save_start = std::chrono::steady_clock::now();
-      if (!pcl_ms_mpi::writePlyFromInput(options.output, options.input, input.layout,
-                                         result.triangles, error))
-        status = pcl_ms_tools::kIoFailure;
-      save_ms =
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - save_start)
-              .count();
-      if (verbose) {
-        if (status == kSuccess) {
-          print_info("[done, ");
-          print_value("%.1f", save_ms);
-          print_info(" ms]\n");
-        } else {
-          print_info("[failed]\n");
-        }
-      }
+      saveStreamed([&] {
+        return pcl_ms_mpi::writePlyFromInput(options.output, options.input, input.layout,
+                                             result.triangles, error)
+                   ? kSuccess
+                   : pcl_ms_tools::kIoFailure;
+      });
     } else {
       if (input.in_parts) {
         SilencePclMessages silence;
@@ -516,9 +575,9 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
                                                      save_ms, error);
       }
     }
-    if (status == kSuccess)
-      status = pcl_ms_tools::saveReconstructedMedialAxis(options, result, error);
   }
+  if (on_rank_zero && status == kSuccess)
+    status = pcl_ms_tools::saveReconstructedMedialAxis(options, result, error);
   RankFigures mine{peakResidentMegabytes(),
                    read_mb,
                    result.peak_memory.prepare / 1048576.0,
@@ -532,7 +591,7 @@ int loadMeshAndSave(const Job &job, const pcl_ms_tools::ReconstructOptions &opti
   if (status != kSuccess)
     return on_rank_zero ? fail(status, error) : status;
   if (verbose) {
-    pcl_ms_tools::printReconstructReport(result, load_ms, save_ms);
+    pcl_ms_tools::printReconstructReport(result, load_ms, save_ms, triangle_count);
     printRankTable(figures);
     // Rank 0's peaks (the unit farm: where it goes beyond the others', as it alone finishes).
     const pcl_ms::StagePeakMemory &peaks = result.peak_memory;

@@ -6,7 +6,7 @@
 # seed 20241122 + size). Prints wall time, each rank's and the job's peak
 # resident memory (rank 0 first: the ranks read the binary PCD in parts,
 # mesh their own buckets and seam zones and finish the surface in parts;
-# rank 0 receives the finished triangles to write them), and whether every
+# rank 0 writes the runs as the ranks send them), and whether every
 # mesh is byte-identical to the single-process one. Not part of ctest: 10M
 # points take about 12 minutes on two cores. -work DIR keeps the cloud and
 # each run's log there.

@@ -279,58 +279,75 @@ bool readRecords(const std::string &path, const BinaryCloudLayout &layout, std::
   return true;
 }
 
+bool PlyFromInputWriter::open(const std::string &output, const std::string &input,
+                              const BinaryCloudLayout &layout, std::uint64_t faces) {
+  output_ = output;
+  out_.open(output, std::ios::binary | std::ios::trunc);
+  if (!out_) {
+    reason_ = std::string("cannot open for writing: ") + std::strerror(errno);
+    return false;
+  }
+  created_ = true;
+  // The header pcl::io::savePLYFileBinary writes for such a mesh.
+  out_ << "ply\nformat binary_little_endian 1.0\ncomment PCL generated\nelement vertex "
+       << layout.points << "\nproperty float x\nproperty float y\nproperty float z\nelement face "
+       << faces << "\nproperty list uchar int vertex_indices\nend_header\n";
+  // The vertex block is the input's x y z records as they are.
+  constexpr std::uint64_t block = std::uint64_t(1) << 20;
+  std::vector<unsigned char> bytes;
+  for (std::uint64_t begin = 0; begin < layout.points && reason_.empty(); begin += block) {
+    const std::uint64_t end = std::min(layout.points, begin + block);
+    if (!readRecords(input, layout, begin, end, bytes, reason_))
+      break;
+    out_.write(reinterpret_cast<const char *>(bytes.data()),
+               static_cast<std::streamsize>(bytes.size()));
+  }
+  return reason_.empty();
+}
+
+bool PlyFromInputWriter::add(const std::array<std::uint32_t, 3> *triangles, std::size_t count) {
+  if (!created_ || !reason_.empty())
+    return false;
+  faces_.resize(count * 13);
+  char *at = faces_.data();
+  for (std::size_t t = 0; t < count; ++t) {
+    *at++ = 3;
+    std::memcpy(at, triangles[t].data(), 12);
+    at += 12;
+  }
+  out_.write(faces_.data(), static_cast<std::streamsize>(faces_.size()));
+  return true;
+}
+
+bool PlyFromInputWriter::close(std::string &error) {
+  if (created_) {
+    out_.flush();
+    if (reason_.empty() && !out_)
+      reason_ = std::string("write failed: ") + std::strerror(errno);
+    out_.close();
+  }
+  std::vector<char>().swap(faces_);
+  if (reason_.empty())
+    return true;
+  if (created_) {
+    std::error_code ignored;
+    std::filesystem::remove(output_, ignored);
+  }
+  error = output_ + ": " + reason_;
+  return false;
+}
+
 bool writePlyFromInput(const std::string &output, const std::string &input,
                        const BinaryCloudLayout &layout,
                        const std::vector<std::array<std::uint32_t, 3>> &triangles,
                        std::string &error) {
-  std::string reason;
-  bool created = false;
-  {
-    std::ofstream out(output, std::ios::binary | std::ios::trunc);
-    if (!out) {
-      reason = std::string("cannot open for writing: ") + std::strerror(errno);
-    } else {
-      created = true;
-      // The header pcl::io::savePLYFileBinary writes for such a mesh.
-      out << "ply\nformat binary_little_endian 1.0\ncomment PCL generated\nelement vertex "
-          << layout.points
-          << "\nproperty float x\nproperty float y\nproperty float z\nelement face "
-          << triangles.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
-      // The vertex block is the input's x y z records as they are.
-      constexpr std::uint64_t block = std::uint64_t(1) << 20;
-      std::vector<unsigned char> bytes;
-      for (std::uint64_t begin = 0; begin < layout.points && reason.empty(); begin += block) {
-        const std::uint64_t end = std::min(layout.points, begin + block);
-        if (!readRecords(input, layout, begin, end, bytes, reason))
-          break;
-        out.write(reinterpret_cast<const char *>(bytes.data()),
-                  static_cast<std::streamsize>(bytes.size()));
-      }
-      std::vector<char> faces;
-      for (std::size_t begin = 0; begin < triangles.size() && reason.empty(); begin += block) {
-        const std::size_t end = std::min<std::size_t>(triangles.size(), begin + block);
-        faces.resize((end - begin) * 13);
-        char *at = faces.data();
-        for (std::size_t t = begin; t < end; ++t) {
-          *at++ = 3;
-          std::memcpy(at, triangles[t].data(), 12);
-          at += 12;
-        }
-        out.write(faces.data(), static_cast<std::streamsize>(faces.size()));
-      }
-      out.flush();
-      if (reason.empty() && !out)
-        reason = std::string("write failed: ") + std::strerror(errno);
-    }
+  PlyFromInputWriter writer;
+  if (writer.open(output, input, layout, triangles.size())) {
+    constexpr std::size_t block = std::size_t(1) << 20;
+    for (std::size_t begin = 0; begin < triangles.size(); begin += block)
+      writer.add(triangles.data() + begin, std::min(block, triangles.size() - begin));
   }
-  if (reason.empty())
-    return true;
-  if (created) {
-    std::error_code ignored;
-    std::filesystem::remove(output, ignored);
-  }
-  error = output + ": " + reason;
-  return false;
+  return writer.close(error);
 }
 
 } // namespace pcl_ms_mpi

@@ -8,7 +8,9 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -64,5 +66,24 @@ bool writePlyFromInput(const std::string &output, const std::string &input,
                        const BinaryCloudLayout &layout,
                        const std::vector<std::array<std::uint32_t, 3>> &triangles,
                        std::string &error);
+
+/// writePlyFromInput for triangles that come a piece at a time: open()
+/// writes the header for `faces` triangles and the vertices, add() appends
+/// triangles, close() ends the file. Once a step fails the others do
+/// nothing and return false; close() then gives the reason and leaves no
+/// file.
+class PlyFromInputWriter {
+public:
+  bool open(const std::string &output, const std::string &input, const BinaryCloudLayout &layout,
+            std::uint64_t faces);
+  bool add(const std::array<std::uint32_t, 3> *triangles, std::size_t count);
+  bool close(std::string &error);
+
+private:
+  std::ofstream out_;
+  std::string output_, reason_;
+  bool created_ = false;
+  std::vector<char> faces_; // one piece's bytes
+};
 
 } // namespace pcl_ms_mpi

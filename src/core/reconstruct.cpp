@@ -318,6 +318,8 @@ void addMedialAxis(const PreparedPoints &prepared, const std::vector<Triangle> &
                    const Deadline &deadline, Result &result);
 /// The finished surface into `result`, in the user's records.
 void takeFinishedSurface(FinishedSurface &&surface, const PreparedPoints &prepared, Result &result);
+/// The finished surface, whose numbers are the user's records, into `result`.
+void moveFinishedSurface(FinishedSurface &&surface, Result &result);
 void checkParameters(const Parameters &parameters, bool has_normals) {
   const std::string invalid = parameters.validate();
   if (!invalid.empty())
@@ -343,8 +345,11 @@ Result reconstruct(const PointView &points, const Parameters &parameters,
   return reconstructShared(points, parameters, initial_triangles, one_process);
 }
 
-Result reconstructSlices(PreparedSlice &&slice, const Parameters &parameters, ProcessGroup &group) {
+Result reconstructSlices(PreparedSlice &&slice, const Parameters &parameters, ProcessGroup &group,
+                         FinishedRun *runs) {
   const Clock::time_point start = Clock::now();
+  if (runs)
+    *runs = FinishedRun(); // unused unless bucketed
   checkParameters(parameters, true);
   std::vector<double> missing_normals{
       parameters.use_normals && slice.points.normals.size() != slice.points.positions.size() ? 1.0
@@ -371,7 +376,7 @@ Result reconstructSlices(PreparedSlice &&slice, const Parameters &parameters, Pr
     return meshPrepared(joined, {}, parameters, one_process, deadline, start, std::move(result));
   }
   result.peak_memory.prepare = peakResidentBytes();
-  SharedSurface shared = meshSlicesInBuckets(slice, parameters, &deadline, group);
+  SharedSurface shared = meshSlicesInBuckets(slice, parameters, &deadline, group, runs != nullptr);
   slice = PreparedSlice();
   returnFreeHeapPages();
   result.d_med = shared.surface.d_med;
@@ -383,7 +388,11 @@ Result reconstructSlices(PreparedSlice &&slice, const Parameters &parameters, Pr
   result.timings.finish = shared.finish_seconds;
   result.peak_memory.scaffold = result.peak_memory.greedy = result.peak_memory.finish =
       std::max(result.peak_memory.prepare, peakResidentBytes());
-  if (group.process() == 0) {
+  if (shared.run.used) {
+    *runs = std::move(shared.run);
+    if (group.process() == 0)
+      moveFinishedSurface(std::move(shared.finished), result); // in the user's records
+  } else if (group.process() == 0) {
     if (parameters.compute_medial_axis)
       addMedialAxis(shared.points, shared.finished.triangles, deadline, result);
     takeFinishedSurface(std::move(shared.finished), shared.points, result);
@@ -563,6 +572,10 @@ void takeFinishedSurface(FinishedSurface &&surface, const PreparedPoints &prepar
   for (auto &loop : surface.boundary_loops)
     for (VertexIndex &v : loop)
       v = prepared.user_index[v];
+  moveFinishedSurface(std::move(surface), result);
+}
+
+void moveFinishedSurface(FinishedSurface &&surface, Result &result) {
   result.triangles = std::move(surface.triangles);
   result.boundary_loops = std::move(surface.boundary_loops);
   result.triangle_component = std::move(surface.triangle_component);

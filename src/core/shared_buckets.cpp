@@ -16,6 +16,7 @@
 #include "cuts_in_parts.h"
 #include "finish_in_parts.h"
 #include "median_spacing.h"
+#include "points_from_homes.h"
 #include "process_bytes.h"
 #include "shared_tree.h"
 #include "threads.h"
@@ -106,10 +107,10 @@ using Node = detail::TreeNode;
 class SharedBuckets {
 public:
   SharedBuckets(const PreparedSlice &slice, const Parameters &parameters, const Deadline *deadline,
-                ProcessGroup &group)
+                ProcessGroup &group, bool in_runs)
       : home_(slice.points), first_(slice.first), total_(slice.total), parameters_(parameters),
-        deadline_(deadline), group_(group), home_scale_(home_.positions.size(), 0.0f),
-        home_pinch_(home_.positions.size(), 0) {
+        deadline_(deadline), group_(group), in_runs_(in_runs && !parameters.compute_medial_axis),
+        home_scale_(home_.positions.size(), 0.0f), home_pinch_(home_.positions.size(), 0) {
     home_first_ = detail::firstsOf(countsOf(home_.positions.size(), group_));
   }
 
@@ -733,7 +734,10 @@ private:
     shared.finish_seconds = secondsSince(stage);
     if (deadline_)
       deadline_->check("the finish");
-    gatherFinished(part, shared);
+    if (in_runs_)
+      keepFinishedInRuns(part, shared);
+    else
+      gatherFinished(part, shared);
     return shared;
   }
 
@@ -774,30 +778,104 @@ private:
   /// Process 0 gets the finished surface: the triangles, their components
   /// numbered in the order of their first triangles, the loops, the
   /// figures, and every point's record in the user's cloud.
-  void gatherFinished(detail::FinishedPart &part, SharedSurface &shared) {
-    FinishedSurface &finished = shared.finished;
+  /// Every component's first triangle, with whether it is orientable.
+  struct ComponentStart {
+    std::uint64_t first;
+    std::uint64_t orientable;
+  };
+
+  /// Every process gets every component's start, in list order; process 0's
+  /// `finished` its figures, loops and components' orientability.
+  std::vector<ComponentStart> componentStarts(detail::FinishedPart &part,
+                                              FinishedSurface &finished) {
     finished.holes_filled = part.holes_filled;
     finished.twist_triangles_removed = part.twist_triangles_removed;
     finished.boundary_loops = std::move(part.boundary_loops);
-    // Every component's first triangle, with whether it is orientable, to all.
-    struct ComponentStart {
-      std::uint64_t first;
-      std::uint64_t orientable;
-    };
-    std::vector<ComponentStart> starts;
-    {
-      std::vector<ComponentStart> mine;
-      for (std::size_t t = 0; t < part.triangles.size(); ++t)
-        if (part.component[t] == part.first + t)
-          mine.push_back({part.component[t], part.orientable[t]});
-      const std::uint64_t components = totalOver(mine.size(), group_);
-      if (group_.process() == 0)
-        starts.resize(components);
-      gatherAtZero<ComponentStart>(
-          mine.size(), [&](std::size_t i) { return mine[i]; },
-          [&](std::size_t c, const ComponentStart &start) { starts[c] = start; }, group_);
-      fromZeroToAll(starts, group_);
+    std::vector<ComponentStart> starts, mine;
+    for (std::size_t t = 0; t < part.triangles.size(); ++t)
+      if (part.component[t] == part.first + t)
+        mine.push_back({part.component[t], part.orientable[t]});
+    const std::uint64_t components = totalOver(mine.size(), group_);
+    if (group_.process() == 0)
+      starts.resize(components);
+    gatherAtZero<ComponentStart>(
+        mine.size(), [&](std::size_t i) { return mine[i]; },
+        [&](std::size_t c, const ComponentStart &start) { starts[c] = start; }, group_);
+    fromZeroToAll(starts, group_);
+    if (group_.process() == 0)
+      for (const ComponentStart &start : starts)
+        finished.component_orientable.push_back(start.orientable != 0);
+    return starts;
+  }
+
+  /// The number, among `starts`, of the component that starts at `first`.
+  static std::uint32_t componentNumber(const std::vector<ComponentStart> &starts,
+                                       std::uint64_t first) {
+    const auto at =
+        std::lower_bound(starts.begin(), starts.end(), first,
+                         [](const ComponentStart &a, std::uint64_t b) { return a.first < b; });
+    return static_cast<std::uint32_t>(at - starts.begin());
+  }
+
+  /// Collective. Every point number that forEachVertex(visit) visits (a
+  /// VertexIndex &) becomes its point's record in the user's cloud, asked
+  /// once from the point's home.
+  template <typename ForEachVertex> void toUserRecords(const ForEachVertex &forEachVertex) {
+    std::vector<VertexIndex> vertices;
+    forEachVertex([&](VertexIndex &v) { vertices.push_back(v); });
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    const std::vector<VertexIndex> records = detail::valuesFromHomes<VertexIndex>(
+        vertices, home_first_, first_, [&](std::size_t i) { return home_.user_index[i]; }, group_);
+    forEachVertex([&](VertexIndex &v) {
+      v = records[static_cast<std::size_t>(std::lower_bound(vertices.begin(), vertices.end(), v) -
+                                           vertices.begin())];
+    });
+  }
+
+  /// Every process keeps its run of the finished surface, in the user's
+  /// records with its components' numbers; process 0 gets the loops in the
+  /// user's records and the figures.
+  void keepFinishedInRuns(detail::FinishedPart &part, SharedSurface &shared) {
+    const std::vector<ComponentStart> starts = componentStarts(part, shared.finished);
+    FinishedRun &run = shared.run;
+    run.used = true;
+    run.first = part.first;
+    run.total = totalOver(part.triangles.size(), group_);
+    run.component.resize(part.triangles.size());
+    for (std::size_t t = 0; t < part.triangles.size(); ++t)
+      run.component[t] = componentNumber(starts, part.component[t]);
+    // Not held while the corners are looked up.
+    std::vector<std::uint64_t>().swap(part.component);
+    std::vector<std::uint8_t>().swap(part.orientable);
+    run.triangles = std::move(part.triangles);
+    // The corners become the user's records a piece of the run at a time:
+    // the lookups stay small beside the run.
+    constexpr std::size_t piece = std::size_t(1) << 20;
+    const std::size_t size = run.triangles.size();
+    const std::uint64_t pieces = detail::maximumOver((size + piece - 1) / piece, group_);
+    for (std::uint64_t k = 0; k < pieces; ++k) {
+      const std::size_t begin = std::min<std::size_t>(size, k * piece);
+      const std::size_t end = std::min(size, begin + piece);
+      toUserRecords([&](const auto &visit) {
+        for (std::size_t t = begin; t < end; ++t)
+          for (VertexIndex &v : run.triangles[t])
+            visit(v);
+      });
     }
+    part = detail::FinishedPart();
+    // The loops are on process 0 only.
+    toUserRecords([&](const auto &visit) {
+      for (auto &loop : shared.finished.boundary_loops)
+        for (VertexIndex &v : loop)
+          visit(v);
+    });
+    shared.points.centre = home_.centre;
+  }
+
+  void gatherFinished(detail::FinishedPart &part, SharedSurface &shared) {
+    FinishedSurface &finished = shared.finished;
+    const std::vector<ComponentStart> starts = componentStarts(part, finished);
     struct NumberedTriangle {
       Triangle corners;
       std::uint32_t component;
@@ -807,17 +885,11 @@ private:
     if (zero) {
       finished.triangles.resize(total);
       finished.triangle_component.resize(total);
-      for (const ComponentStart &start : starts)
-        finished.component_orientable.push_back(start.orientable != 0);
     }
     gatherAtZero<NumberedTriangle>(
         part.triangles.size(),
         [&](std::size_t t) {
-          const auto at = std::lower_bound(
-              starts.begin(), starts.end(), part.component[t],
-              [](const ComponentStart &a, std::uint64_t b) { return a.first < b; });
-          return NumberedTriangle{part.triangles[t],
-                                  static_cast<std::uint32_t>(at - starts.begin())};
+          return NumberedTriangle{part.triangles[t], componentNumber(starts, part.component[t])};
         },
         [&](std::size_t t, const NumberedTriangle &triangle) {
           finished.triangles[t] = triangle.corners;
@@ -843,6 +915,7 @@ private:
   const Parameters &parameters_;
   const Deadline *deadline_;
   ProcessGroup &group_;
+  const bool in_runs_;                    // the finished surface stays in runs (no medial axis)
   std::vector<std::uint64_t> home_first_; // process p's home points start at home_first_[p]
   std::vector<float> home_scale_;
   std::vector<std::uint8_t> home_pinch_;
@@ -899,8 +972,8 @@ PreparedPoints joinSlicesAtProcessZero(const PreparedPoints &slice, bool with_no
 }
 
 SharedSurface meshSlicesInBuckets(const PreparedSlice &slice, const Parameters &parameters,
-                                  const Deadline *deadline, ProcessGroup &group) {
-  return SharedBuckets(slice, parameters, deadline, group).run();
+                                  const Deadline *deadline, ProcessGroup &group, bool in_runs) {
+  return SharedBuckets(slice, parameters, deadline, group, in_runs).run();
 }
 
 } // namespace pcl_ms

@@ -438,7 +438,8 @@ void printRow(const char *label, const char *format, double value) {
   print_info("\n");
 }
 
-void printReconstructReport(const pcl_ms::Result &result, double load_ms, double save_ms) {
+void printReconstructReport(const pcl_ms::Result &result, double load_ms, double save_ms,
+                            std::size_t triangles) {
   const pcl_ms::StageTimings &timings = result.timings;
   print_info("\nTimings (ms):\n");
   printRow("load", "%10.1f", load_ms);
@@ -457,7 +458,7 @@ void printReconstructReport(const pcl_ms::Result &result, double load_ms, double
   printRow("invalid points skipped", "%10.0f", static_cast<double>(result.invalid_points));
   printRow("duplicates merged", "%10.0f", static_cast<double>(result.duplicate_points));
   printRow("far points left out", "%10.0f", static_cast<double>(result.far_points));
-  printRow("triangles", "%10.0f", static_cast<double>(result.triangles.size()));
+  printRow("triangles", "%10.0f", static_cast<double>(triangles));
   printRow("boundary loops", "%10.0f", static_cast<double>(result.boundary_loops.size()));
   printRow("holes filled", "%10.0f", static_cast<double>(result.holes_filled));
   printRow("fold triangles cut", "%10.0f", static_cast<double>(result.twist_triangles_removed));

@@ -89,8 +89,10 @@ int saveReconstructedMesh(const ReconstructOptions &options, pcl::PCLPointCloud2
 
 void printRow(const char *label, const char *format, double value);
 
-/// Timings and summary after a successful run.
-void printReconstructReport(const pcl_ms::Result &result, double load_ms, double save_ms);
+/// Timings and summary after a successful run, of `triangles` triangles
+/// (result.triangles', unless they were written in runs).
+void printReconstructReport(const pcl_ms::Result &result, double load_ms, double save_ms,
+                            std::size_t triangles);
 
 /// Buckets and seams done, elapsed time and a linear estimate of the rest:
 /// rewritten in place on a terminal, else one line a second.

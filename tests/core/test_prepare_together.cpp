@@ -190,21 +190,60 @@ TEST(PrepareTogether, TooFewPointsFailOnEveryProcessAsInOne) {
 // ---- buckets by owner: meshSlicesInBuckets through reconstructSlices ---------
 
 /// Each process prepares its part of `xyz` and meshes the slices with the
-/// others; returns every process's result.
+/// others; returns every process's result (and its run of the surface, when
+/// `runs` is given).
 std::vector<pcl_ms::Result> reconstructInParts(const std::vector<float> &xyz,
                                                const std::vector<float> &normals,
                                                const std::vector<std::size_t> &cuts,
-                                               const pcl_ms::Parameters &parameters) {
+                                               const pcl_ms::Parameters &parameters,
+                                               std::vector<pcl_ms::FinishedRun> *runs = nullptr) {
   const int processes = static_cast<int>(cuts.size()) - 1;
   std::vector<pcl_ms::Result> results(processes);
+  if (runs)
+    runs->assign(static_cast<std::size_t>(processes), pcl_ms::FinishedRun());
   onThreadProcesses(processes, [&](pcl_ms::ProcessGroup &group) {
     const int p = group.process();
     results[p] = pcl_ms::reconstructSlices(
         pcl_ms::preparePointsTogether(partOf(xyz, normals, cuts, p), cuts[p],
                                       parameters.use_normals, group),
-        parameters, group);
+        parameters, group, runs ? &(*runs)[static_cast<std::size_t>(p)] : nullptr);
   });
   return results;
+}
+
+/// reconstructSlices asked to leave the surface in runs: a bucketed cloud
+/// without the medial axis gives the one-process triangles and components
+/// in runs (process 0's result has none), the rest as gathered.
+void expectTheSurfaceInRuns(const std::vector<float> &xyz, const std::vector<float> &normals,
+                            const std::vector<std::size_t> &cuts,
+                            const pcl_ms::Parameters &parameters, const pcl_ms::Result &reference) {
+  std::vector<pcl_ms::FinishedRun> runs;
+  const std::vector<pcl_ms::Result> results =
+      reconstructInParts(xyz, normals, cuts, parameters, &runs);
+  const bool in_runs = reference.bucket_statistics.buckets > 0 && !parameters.compute_medial_axis;
+  const std::string where = std::to_string(results.size()) + " processes, in runs";
+  std::vector<pcl_ms::Triangle> triangles;
+  std::vector<std::uint32_t> components;
+  for (const pcl_ms::FinishedRun &run : runs) {
+    EXPECT_EQ(run.used, in_runs) << where;
+    EXPECT_EQ(run.first, triangles.size()) << where;
+    EXPECT_EQ(run.total, in_runs ? reference.triangles.size() : 0u) << where;
+    EXPECT_EQ(run.triangles.size(), run.component.size()) << where;
+    triangles.insert(triangles.end(), run.triangles.begin(), run.triangles.end());
+    components.insert(components.end(), run.component.begin(), run.component.end());
+  }
+  if (in_runs) {
+    EXPECT_EQ(triangles, reference.triangles) << where;
+    EXPECT_EQ(components, reference.triangle_component) << where;
+    EXPECT_TRUE(results[0].triangles.empty()) << where;
+    EXPECT_TRUE(results[0].triangle_component.empty()) << where;
+  } else {
+    EXPECT_EQ(results[0].triangles, reference.triangles) << where;
+  }
+  EXPECT_EQ(results[0].boundary_loops, reference.boundary_loops) << where;
+  EXPECT_EQ(results[0].component_orientable, reference.component_orientable) << where;
+  EXPECT_EQ(results[0].holes_filled, reference.holes_filled) << where;
+  EXPECT_EQ(results[0].twist_triangles_removed, reference.twist_triangles_removed) << where;
 }
 
 void expectOneProcessMesh(const std::vector<float> &xyz, const std::vector<float> &normals,
@@ -246,6 +285,7 @@ void expectOneProcessMesh(const std::vector<float> &xyz, const std::vector<float
               expected.bow_tie_triangles_removed);
     for (std::size_t p = 1; p < results.size(); ++p)
       EXPECT_TRUE(results[p].triangles.empty()) << "process " << p;
+    expectTheSurfaceInRuns(xyz, normals, cutsFor(xyz.size() / 3, fractions), parameters, reference);
   }
 }
 

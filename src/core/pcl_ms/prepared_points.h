@@ -69,15 +69,29 @@ struct PreparedSlice {
 PreparedSlice preparePointsTogether(const PointView &part, std::uint64_t first_record,
                                     bool with_normals, ProcessGroup &group);
 
+/// A process's run of the finished surface, left where it was finished
+/// (reconstructSlices' `runs`): the whole list is the runs in process
+/// order, the same list as Result::triangles, in the user's records.
+struct FinishedRun {
+  bool used = false; // the same on every process: the surface is in the runs
+  std::vector<Triangle> triangles;
+  std::vector<std::uint32_t> component; // as Result::triangle_component
+  std::uint64_t first = 0;              // the number of triangles[0] in the whole list
+  std::uint64_t total = 0;              // triangles in the whole list
+};
+
 /// What meshSlicesInBuckets gives: on process 0, the finished surface in
 /// the prepared order's numbers and the points' records in the user's
 /// cloud (`points.user_index`; their positions too when the medial axis is
 /// asked for); on every process, the buckets' figures and times
-/// (`surface`, without triangles).
+/// (`surface`, without triangles). In runs (`in_runs`), process 0 has the
+/// loops in the user's records and no triangles or points: every process
+/// has its run.
 struct SharedSurface {
   PreparedPoints points;
   BucketedSurface surface;
   FinishedSurface finished;
+  FinishedRun run;
   double finish_seconds = 0;
 };
 
@@ -86,11 +100,13 @@ struct SharedSurface {
 /// bucket it owns, with the points those need sent to it, then finishes the
 /// surface with the triangles in runs over the processes
 /// (detail::finishInParts): no process holds all the points or all the
-/// triangles until process 0 receives the finished triangles at the end.
+/// triangles, unless process 0 receives the finished triangles at the end
+/// (`in_runs` false, or the medial axis).
 /// The same surface as meshInBuckets then finishSurface on the joined
 /// points. Collective.
 SharedSurface meshSlicesInBuckets(const PreparedSlice &slice, const Parameters &parameters,
-                                  const Deadline *deadline, ProcessGroup &group);
+                                  const Deadline *deadline, ProcessGroup &group,
+                                  bool in_runs = false);
 
 /// Process 0 gets all processes' slices joined in process order (the
 /// prepared order); the others get nothing. Collective.
@@ -100,7 +116,12 @@ PreparedPoints joinSlicesAtProcessZero(const PreparedPoints &slice, bool with_no
 /// reconstruct() for the slices of preparePointsTogether: a bucketed cloud
 /// is meshed by meshSlicesInBuckets, one piece by process 0 alone; process
 /// 0 finishes the surface and gets the result, the others the preparation's
-/// and the buckets' figures and no triangles. Collective.
-Result reconstructSlices(PreparedSlice &&slice, const Parameters &parameters, ProcessGroup &group);
+/// and the buckets' figures and no triangles. Given `runs`, a bucketed
+/// cloud without the medial axis leaves the triangles in runs
+/// (`runs->used` on every process): process 0's result then has no
+/// triangles or triangle components, so that no process holds the whole
+/// surface. Collective.
+Result reconstructSlices(PreparedSlice &&slice, const Parameters &parameters, ProcessGroup &group,
+                         FinishedRun *runs = nullptr);
 
 } // namespace pcl_ms
