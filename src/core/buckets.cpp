@@ -9,6 +9,7 @@
 
 #include "bucket_parts.h"
 #include "median_spacing.h"
+#include "sort_unique.h"
 #include "threads.h"
 
 #include <algorithm>
@@ -493,8 +494,7 @@ private:
             frozen.push_back(v);
       }
     }
-    std::sort(frozen.begin(), frozen.end());
-    frozen.erase(std::unique(frozen.begin(), frozen.end()), frozen.end());
+    detail::sortUnique(frozen);
     std::vector<VertexIndex> &members = planned.members;
     members.reserve(zone.size() + frozen.size());
     std::merge(zone.begin(), zone.end(), frozen.begin(), frozen.end(), std::back_inserter(members));
@@ -635,10 +635,7 @@ BucketOutcome meshBucket(const BucketTask &task, const Parameters &parameters,
         if (task.core[v])
           outcome.cut_vertices.push_back(v);
     }
-    std::sort(outcome.cut_vertices.begin(), outcome.cut_vertices.end());
-    outcome.cut_vertices.erase(
-        std::unique(outcome.cut_vertices.begin(), outcome.cut_vertices.end()),
-        outcome.cut_vertices.end());
+    detail::sortUnique(outcome.cut_vertices);
   } catch (const TimeLimitExceeded &) {
     throw; // the whole run stops, not just this unit
   } catch (const ReconstructionError &error) {

@@ -2,6 +2,7 @@
 // The twist repair's cut and the bow-tie split over a triangle list held in
 // parts (cuts_in_parts.h; docs/algorithm.md, "Finishing in parts").
 #include "cuts_in_parts.h"
+#include "sort_unique.h"
 
 #include "finish_steps.h"
 #include "process_bytes.h"
@@ -29,8 +30,7 @@ std::vector<VertexIndex> cornersOf(const std::vector<Triangle> &triangles,
   for (std::size_t t = 0; t < triangles.size(); ++t)
     if (marked[t])
       corners.insert(corners.end(), triangles[t].begin(), triangles[t].end());
-  std::sort(corners.begin(), corners.end());
-  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  detail::sortUnique(corners);
   return corners;
 }
 
@@ -60,8 +60,7 @@ std::vector<std::uint64_t> bowTieTriangles(std::vector<AtVertex> &at) {
       going.push_back(at[i + local].triangle);
     i = j;
   }
-  std::sort(going.begin(), going.end());
-  going.erase(std::unique(going.begin(), going.end()), going.end());
+  detail::sortUnique(going);
   return going;
 }
 
@@ -108,8 +107,7 @@ CutPart cutInParts(const std::vector<Triangle> &mine, std::uint64_t first,
     gatherAtZero<VertexIndex>(
         check.size(), [&](std::size_t i) { return check[i]; },
         [&](std::size_t, VertexIndex v) { all_check.push_back(v); }, group);
-    std::sort(all_check.begin(), all_check.end());
-    all_check.erase(std::unique(all_check.begin(), all_check.end()), all_check.end());
+    detail::sortUnique(all_check);
     if (totalOver(all_check.size(), group) == 0)
       break;
     fromZeroToAll(all_check, group);

@@ -4,6 +4,7 @@
 // cut, bow-ties split, components oriented, boundary loops traced. The steps
 // are in hole_filling.cpp, orientation.cpp, bow_ties.cpp; this file drives them.
 #include "finish_steps.h"
+#include "sort_unique.h"
 
 #include <algorithm>
 #include <array>
@@ -218,8 +219,7 @@ void addFilling(MeshEdges &edges, const std::vector<Triangle> &triangles, std::s
     i = j;
   }
   // Each relinked triangle's slots back in the order of the edges' keys.
-  std::sort(relinked.begin(), relinked.end());
-  relinked.erase(std::unique(relinked.begin(), relinked.end()), relinked.end());
+  detail::sortUnique(relinked);
   for (std::uint32_t t : relinked) {
     std::uint32_t *slots = &edges.neighbours[3 * std::size_t{t}];
     std::array<std::pair<EdgeKey, std::uint32_t>, 3> by_key;

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "edge_key.h"
+#include "sort_unique.h"
 #include "threads.h"
 
 #include <pcl_ms/finish.h>
@@ -182,10 +183,8 @@ void edgesAndTrianglesAmong(const std::vector<Triangle> &triangles, const OnLoop
       corners.push_back(sorted);
     }
   }
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  std::sort(corners.begin(), corners.end());
-  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  detail::sortUnique(edges);
+  detail::sortUnique(corners);
 }
 
 /// fillLoops' last step, given fillableLoops' loops and the mesh's edges

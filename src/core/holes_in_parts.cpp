@@ -2,6 +2,7 @@
 // Hole filling over a triangle list held in parts (holes_in_parts.h;
 // docs/algorithm.md, "Finishing in parts").
 #include "holes_in_parts.h"
+#include "sort_unique.h"
 
 #include "finish_steps.h"
 #include "numbering.h"
@@ -77,8 +78,7 @@ HolesPart fillHolesInParts(const std::vector<Triangle> &mine, const MeshEdgesPar
     gatherAtZero<VertexIndex>(
         mine_marked, [&](std::size_t i) { return (*around)[i]; },
         [&](std::size_t, VertexIndex v) { marked.push_back(v); }, group);
-    std::sort(marked.begin(), marked.end());
-    marked.erase(std::unique(marked.begin(), marked.end()), marked.end());
+    detail::sortUnique(marked);
   }
 
   // Process 0: the loops and those to fill; their vertices to everyone.
@@ -131,10 +131,8 @@ HolesPart fillHolesInParts(const std::vector<Triangle> &mine, const MeshEdgesPar
   // last process in the list's numbers.
   std::vector<std::vector<Triangle>> filling_out(processes);
   if (on_zero) {
-    std::sort(mesh_edges.begin(), mesh_edges.end());
-    mesh_edges.erase(std::unique(mesh_edges.begin(), mesh_edges.end()), mesh_edges.end());
-    std::sort(existing.begin(), existing.end());
-    existing.erase(std::unique(existing.begin(), existing.end()), existing.end());
+    detail::sortUnique(mesh_edges);
+    detail::sortUnique(existing);
     std::vector<Eigen::Vector3d> points;
     std::vector<float> scales;
     points.reserve(loop_points.size());

@@ -6,6 +6,7 @@
 #include <pcl_ms/reconstruct.h>
 
 #include "indexed_delaunay.h"
+#include "sort_unique.h"
 
 #include <CGAL/constructions/kernel_ftC3.h>
 #include <Eigen/Geometry>
@@ -228,8 +229,7 @@ private:
       if (key[0] != key[1] && key[1] != key[2])
         triangles.push_back(key);
     }
-    std::sort(triangles.begin(), triangles.end());
-    triangles.erase(std::unique(triangles.begin(), triangles.end()), triangles.end());
+    detail::sortUnique(triangles);
 
     // Components by shared edges (union-find over triangles).
     std::vector<std::uint32_t> parent(triangles.size());
@@ -331,8 +331,7 @@ private:
           around.insert(around.end(), triangles[use->triangle].begin(),
                         triangles[use->triangle].end());
       }
-      std::sort(around.begin(), around.end());
-      around.erase(std::unique(around.begin(), around.end()), around.end());
+      detail::sortUnique(around);
       for (std::size_t i = 0; i < around.size(); ++i)
         for (std::size_t j = i + 1; j < around.size(); ++j)
           for (std::size_t k = j + 1; k < around.size(); ++k) {

@@ -4,6 +4,8 @@
 // (docs/algorithm.md, "Finishing in parts"). Internal: not installed.
 #pragma once
 
+#include "sort_unique.h"
+
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -16,10 +18,7 @@ namespace detail {
 template <typename Id> class Numbering {
 public:
   /// The distinct ids among those given, repeats allowed.
-  explicit Numbering(std::vector<Id> ids) : ids_(std::move(ids)) {
-    std::sort(ids_.begin(), ids_.end());
-    ids_.erase(std::unique(ids_.begin(), ids_.end()), ids_.end());
-  }
+  explicit Numbering(std::vector<Id> ids) : ids_(std::move(ids)) { detail::sortUnique(ids_); }
   /// The number of `id`, one of the ids given.
   std::uint32_t operator()(Id id) const {
     return static_cast<std::uint32_t>(std::lower_bound(ids_.begin(), ids_.end(), id) -

@@ -2,6 +2,7 @@
 // Corner points from their homes (points_from_homes.h; docs/algorithm.md,
 // "Finishing in parts").
 #include "points_from_homes.h"
+#include "sort_unique.h"
 
 #include <algorithm>
 #include <array>
@@ -23,8 +24,7 @@ std::vector<VertexIndex> cornersOf(const std::vector<Triangle> &mine, std::size_
   vertices.reserve(3 * (mine.size() - from));
   for (std::size_t t = from; t < mine.size(); ++t)
     vertices.insert(vertices.end(), mine[t].begin(), mine[t].end());
-  std::sort(vertices.begin(), vertices.end());
-  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  detail::sortUnique(vertices);
   return vertices;
 }
 

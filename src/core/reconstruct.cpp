@@ -12,6 +12,7 @@
 
 #include "far_points.h"
 #include "point_keys.h"
+#include "sort_unique.h"
 #include "threads.h"
 
 #include <algorithm>
@@ -252,8 +253,7 @@ std::vector<Triangle> preparePreferredTriangles(const std::vector<Triangle> &ini
 std::size_t countKept(std::vector<Triangle> initial, const std::vector<Triangle> &mesh) {
   for (Triangle &triangle : initial)
     std::sort(triangle.begin(), triangle.end());
-  std::sort(initial.begin(), initial.end());
-  initial.erase(std::unique(initial.begin(), initial.end()), initial.end());
+  detail::sortUnique(initial);
   std::size_t kept = 0;
   for (Triangle triangle : mesh) {
     std::sort(triangle.begin(), triangle.end());

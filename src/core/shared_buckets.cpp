@@ -19,6 +19,7 @@
 #include "points_from_homes.h"
 #include "process_bytes.h"
 #include "shared_tree.h"
+#include "sort_unique.h"
 #include "threads.h"
 
 #include <algorithm>
@@ -547,8 +548,7 @@ private:
             frozen.push_back(v);
       }
       std::vector<FixedFor>().swap(parts);
-      std::sort(frozen.begin(), frozen.end());
-      frozen.erase(std::unique(frozen.begin(), frozen.end()), frozen.end());
+      detail::sortUnique(frozen);
       for (VertexIndex v : frozen)
         requests[static_cast<std::size_t>(homeOf(v))].push_back({v, static_cast<std::uint32_t>(z)});
     }
@@ -775,9 +775,6 @@ private:
     return run;
   }
 
-  /// Process 0 gets the finished surface: the triangles, their components
-  /// numbered in the order of their first triangles, the loops, the
-  /// figures, and every point's record in the user's cloud.
   /// Every component's first triangle, with whether it is orientable.
   struct ComponentStart {
     std::uint64_t first;
@@ -823,8 +820,7 @@ private:
   template <typename ForEachVertex> void toUserRecords(const ForEachVertex &forEachVertex) {
     std::vector<VertexIndex> vertices;
     forEachVertex([&](VertexIndex &v) { vertices.push_back(v); });
-    std::sort(vertices.begin(), vertices.end());
-    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    detail::sortUnique(vertices);
     const std::vector<VertexIndex> records = detail::valuesFromHomes<VertexIndex>(
         vertices, home_first_, first_, [&](std::size_t i) { return home_.user_index[i]; }, group_);
     forEachVertex([&](VertexIndex &v) {
@@ -870,9 +866,11 @@ private:
         for (VertexIndex &v : loop)
           visit(v);
     });
-    shared.points.centre = home_.centre;
   }
 
+  /// Process 0 gets the finished surface: the triangles, their components
+  /// numbered in the order of their first triangles, the loops, the
+  /// figures, and every point's record in the user's cloud.
   void gatherFinished(detail::FinishedPart &part, SharedSurface &shared) {
     FinishedSurface &finished = shared.finished;
     const std::vector<ComponentStart> starts = componentStarts(part, finished);

@@ -2,6 +2,7 @@
 // Each orientable component's side over a triangle list held in parts
 // (sides_in_parts.h; docs/algorithm.md, "Finishing in parts").
 #include "sides_in_parts.h"
+#include "sort_unique.h"
 
 #include "exact_signs.h"
 #include "process_bytes.h"
@@ -61,8 +62,7 @@ std::vector<std::uint8_t> sideTurnsInParts(const std::vector<Triangle> &mine, st
   for (std::size_t t = 0; t < count; ++t)
     if (components.orientable[t])
       held.push_back(components.component[t]);
-  std::sort(held.begin(), held.end());
-  held.erase(std::unique(held.begin(), held.end()), held.end());
+  detail::sortUnique(held);
 
   // The terms of one process's sums (orientation.cpp), from the triangles
   // turned to agree with their components' first triangles.
@@ -102,8 +102,7 @@ std::vector<std::uint8_t> sideTurnsInParts(const std::vector<Triangle> &mine, st
   std::vector<std::uint64_t> owned;
   for (const SidePartial &partial : partials)
     owned.push_back(partial.component);
-  std::sort(owned.begin(), owned.end());
-  owned.erase(std::unique(owned.begin(), owned.end()), owned.end());
+  detail::sortUnique(owned);
   ExactSigns owned_volume(owned.size()), owned_facing(owned.size());
   std::vector<std::uint8_t> owned_open(owned.size(), 0);
   for (const SidePartial &partial : partials) {

@@ -2,6 +2,7 @@
 // The twist repair's spanning forest over a triangle list held in parts
 // (twists_in_parts.h; docs/algorithm.md, "Finishing in parts").
 #include "twists_in_parts.h"
+#include "sort_unique.h"
 
 #include "finish_steps.h"
 #include "pieces_in_parts.h"
@@ -229,8 +230,7 @@ TwistsPart twistForestInParts(const std::vector<Triangle> &mine, std::uint64_t f
 
     // Answers: each piece's turn to the processes holding it, and the edges
     // between runs left inconsistent to the holder of their lower triangle.
-    std::sort(holders.begin(), holders.end());
-    holders.erase(std::unique(holders.begin(), holders.end()), holders.end());
+    detail::sortUnique(holders);
     std::vector<std::vector<PieceTurn>> turns_out(processes);
     for (const auto &[id, process] : holders)
       turns_out[process].push_back({id, piece_flip[numberOf(id)]});
