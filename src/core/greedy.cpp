@@ -158,35 +158,25 @@ void GreedyMesher::Impl::rankPreferredTriangles() {
 /// eps2 that accepted triangle `from` adds to candidate `to` across edge
 /// slot k of `from`.
 double GreedyMesher::Impl::contextTerm(CandidateIndex from, int k, CandidateIndex to) const {
-  const Candidate &source = candidates_[from];
-  const Candidate &target = candidates_[to];
-  const VertexIndex p = source.vertices[k], q = source.vertices[(k + 1) % 3];
-  const VertexIndex source_apex = source.vertices[(k + 2) % 3];
-  VertexIndex target_apex = target.vertices[0];
-  for (VertexIndex v : target.vertices)
-    if (v != p && v != q)
-      target_apex = v;
-  const double edge_length = (points_[q] - points_[p]).norm();
-  const double angle =
-      bendingAngle(points_[p], points_[q], points_[source_apex], points_[target_apex]);
-  return contextCost(edge_length, target.inverse_shock_compactness, angle);
+  return ContextAcross(*this, from, k).termFor(to);
 }
 
 /// Adds (sign +1) or removes (sign -1) accepted triangle t's context from
 /// every candidate sharing one of its edges, accepted ones included: their
 /// current cost is what error recovery compares against.
 void GreedyMesher::Impl::propagateContext(CandidateIndex t, double sign) {
-  const Candidate &candidate = candidates_[t];
-  for (int k = 0; k < 3; ++k)
-    forEachCandidateOn(candidate.edges[k], [&](CandidateIndex s) {
+  for (int k = 0; k < 3; ++k) {
+    const ContextAcross across(*this, t, k);
+    forEachCandidateOn(candidates_[t].edges[k], [&](CandidateIndex s) {
       // Dropped candidates never return; waiting Q2 members get their
       // context recomputed when Q2 is built.
       if (s == t || states_[s].state == State::dropped || isWaitingForQueue2(s))
         return false;
-      states_[s].context += sign * contextTerm(t, k, s);
+      states_[s].context += sign * across.termFor(s);
       refreshCost(s);
       return false;
     });
+  }
 }
 
 /// Context of t from scratch: the sum over accepted triangles on its edges.
@@ -208,16 +198,17 @@ void GreedyMesher::Impl::refreshCost(CandidateIndex t) {
   if (cost == states_[t].cost)
     return;
   states_[t].cost = cost;
-  if (isQueued(t) && !isWaitingForQueue2(t))
+  if (isQueued(t) && !isWaitingForQueue2(t) && cost < states_[t].queued_cost)
     enqueue(t, states_[t].state);
 }
 
 /// Puts t's current cost on the heap of `queue` (its state already).
 void GreedyMesher::Impl::enqueue(CandidateIndex t, State queue) {
   CandidateQueue &heap = queues_[queueNumber(queue)];
+  states_[t].queued_cost = states_[t].cost;
   heap.push(QueueEntry(states_[t].cost, t));
   if (heap.size() > 2 * queued_[queueNumber(queue)] + compaction_slack)
-    heap.compact([&](const QueueEntry &entry) { return isCurrent(entry, queue); });
+    heap.compact([&](const QueueEntry &entry) { return isLive(entry, queue); });
 }
 
 void GreedyMesher::Impl::push(CandidateIndex t, State queue) {
@@ -264,11 +255,15 @@ void GreedyMesher::Impl::runPass(State queue_state, PassStatistics &statistics) 
       __builtin_prefetch(&states_[ahead->candidate()]);
       __builtin_prefetch(&candidates_[ahead->candidate()]);
     }
-    if (!isCurrent(entry, queue_state))
+    if (!isLive(entry, queue_state))
       continue;
+    const CandidateIndex t = entry.candidate();
+    if (states_[t].queued_cost != states_[t].cost) { // it rose: queue it at its cost
+      enqueue(t, queue_state);
+      continue;
+    }
     if (deadline_)
       deadline_->checkEvery(deadline_counter_, "the greedy passes");
-    const CandidateIndex t = entry.candidate();
     --queued_[queueNumber(queue_state)];
     states_[t].state = State::idle;
     ++statistics.popped;

@@ -8,6 +8,7 @@
 #include "candidate_graph.h"
 #include "candidate_queue.h"
 
+#include <pcl_ms/costs.h>
 #include <pcl_ms/greedy.h>
 
 #include <Eigen/Core>
@@ -67,6 +68,34 @@ private:
     return undelayed * delay_multiplier_[states_[t].incidence_delays + states_[t].ranking_delays];
   }
 
+  /// The context an accepted triangle gives across one of its edges: what
+  /// depends on that edge alone, computed once for all its candidates.
+  class ContextAcross {
+  public:
+    ContextAcross(const Impl &greedy, CandidateIndex from, int k)
+        : greedy_(greedy), p_(greedy.candidates_[from].vertices[k]),
+          q_(greedy.candidates_[from].vertices[(k + 1) % 3]),
+          edge_length_((greedy.points_[q_] - greedy.points_[p_]).norm()),
+          bending_(greedy.points_[p_], greedy.points_[q_],
+                   greedy.points_[greedy.candidates_[from].vertices[(k + 2) % 3]]) {}
+    /// eps2 it adds to candidate `to`, on the same edge.
+    double termFor(CandidateIndex to) const {
+      const Candidate &target = greedy_.candidates_[to];
+      VertexIndex apex = target.vertices[0];
+      for (VertexIndex v : target.vertices)
+        if (v != p_ && v != q_)
+          apex = v;
+      return contextCost(edge_length_, target.inverse_shock_compactness,
+                         bending_.angleTo(greedy_.points_[apex]));
+    }
+
+  private:
+    const Impl &greedy_;
+    VertexIndex p_, q_;
+    double edge_length_;
+    BendingAcrossEdge bending_;
+  };
+
   double contextTerm(CandidateIndex from, int k, CandidateIndex to) const;
   void propagateContext(CandidateIndex t, double sign);
   double contextFromScratch(CandidateIndex t) const;
@@ -83,9 +112,11 @@ private:
   }
   int queueNumber(State state) const { return state == State::queue1 ? 0 : 1; }
 
-  bool isCurrent(const QueueEntry &entry, State queue) const {
+  /// Whether `entry` is its candidate's one live entry in `queue`; the
+  /// others are outdated and skipped.
+  bool isLive(const QueueEntry &entry, State queue) const {
     const CandidateState &state = states_[entry.candidate()];
-    return state.state == queue && state.cost == entry.cost();
+    return state.state == queue && state.queued_cost == entry.cost();
   }
 
   void enqueue(CandidateIndex t, State queue);
@@ -196,6 +227,9 @@ private:
   struct CandidateState {
     double context = 0; // sum of eps2 from accepted neighbours
     float cost = 0;     // current cost: (base + context) clamped at 0, times delays
+    // The cost of its live queue entry, at most `cost`: a rise waits until
+    // that entry surfaces (docs/algorithm.md, section 3).
+    float queued_cost = 0;
     State state = State::idle;
     std::uint8_t incidence_delays = 0, ranking_delays = 0, undos = 0;
   };

@@ -62,17 +62,37 @@ inline bool acrossEdge(const Eigen::Vector3d &p, const Eigen::Vector3d &q, const
 
 } // namespace detail
 
+/// Triangle (p, q, t) seen from its edge pq, for the bending angles of
+/// several triangles (p, q, s) against it: what depends on s alone is left
+/// to angleTo.
+class BendingAcrossEdge {
+public:
+  BendingAcrossEdge(const Eigen::Vector3d &p, const Eigen::Vector3d &q, const Eigen::Vector3d &t)
+      : p_(p), axis_(q - p), axis_squared_(axis_.squaredNorm()) {
+    if (axis_squared_ != 0)
+      to_t_ = (t - p) - axis_ * ((t - p).dot(axis_) / axis_squared_);
+  }
+  /// bendingAngle(p, q, t, s).
+  double angleTo(const Eigen::Vector3d &s) const {
+    if (axis_squared_ == 0)
+      return M_PI;
+    const Eigen::Vector3d to_s = (s - p_) - axis_ * ((s - p_).dot(axis_) / axis_squared_);
+    // atan2 of |cross| and dot is accurate near 0 and pi, unlike acos.
+    const double opening = std::atan2(to_t_.cross(to_s).norm(), to_t_.dot(to_s));
+    return M_PI - opening;
+  }
+
+private:
+  Eigen::Vector3d p_, axis_, to_t_;
+  double axis_squared_;
+};
+
 /// Bending angle in [0, pi] between triangles (p, q, t) and (p, q, s) across
 /// their shared edge pq: 0 when s continues the plane of t on the far side,
 /// pi when the two triangles fold onto each other.
 inline double bendingAngle(const Eigen::Vector3d &p, const Eigen::Vector3d &q,
                            const Eigen::Vector3d &t, const Eigen::Vector3d &s) {
-  Eigen::Vector3d to_t, to_s;
-  if (!detail::acrossEdge(p, q, t, s, to_t, to_s))
-    return M_PI;
-  // atan2 of |cross| and dot is accurate near 0 and pi, unlike acos.
-  const double opening = std::atan2(to_t.cross(to_s).norm(), to_t.dot(to_s));
-  return M_PI - opening;
+  return BendingAcrossEdge(p, q, t).angleTo(s);
 }
 
 /// Whether bendingAngle(p, q, t, s) is surely below an angle under pi / 2
