@@ -45,46 +45,36 @@ inline double bendingPenalty(double bending_angle) {
   return grown * grown - 1.0;
 }
 
-namespace detail {
-
-/// The components of t - p and s - p perpendicular to the edge pq; false
-/// when p and q coincide.
-inline bool acrossEdge(const Eigen::Vector3d &p, const Eigen::Vector3d &q, const Eigen::Vector3d &t,
-                       const Eigen::Vector3d &s, Eigen::Vector3d &to_t, Eigen::Vector3d &to_s) {
-  const Eigen::Vector3d axis = q - p;
-  const double axis_squared = axis.squaredNorm();
-  if (axis_squared == 0)
-    return false;
-  to_t = (t - p) - axis * ((t - p).dot(axis) / axis_squared);
-  to_s = (s - p) - axis * ((s - p).dot(axis) / axis_squared);
-  return true;
-}
-
-} // namespace detail
-
 /// Triangle (p, q, t) seen from its edge pq, for the bending angles of
 /// several triangles (p, q, s) against it: what depends on s alone is left
 /// to angleTo.
 class BendingAcrossEdge {
 public:
   BendingAcrossEdge(const Eigen::Vector3d &p, const Eigen::Vector3d &q, const Eigen::Vector3d &t)
-      : p_(p), axis_(q - p), axis_squared_(axis_.squaredNorm()) {
-    if (axis_squared_ != 0)
-      to_t_ = (t - p) - axis_ * ((t - p).dot(axis_) / axis_squared_);
+      : p_(p), axis_(q - p), axis_squared_(axis_.squaredNorm()),
+        to_t_(degenerate() ? Eigen::Vector3d::Zero() : across(t)) {}
+  /// Whether p and q coincide: no bending is defined.
+  bool degenerate() const { return axis_squared_ == 0; }
+  /// The component of s - p perpendicular to the edge (not degenerate).
+  Eigen::Vector3d across(const Eigen::Vector3d &s) const {
+    return (s - p_) - axis_ * ((s - p_).dot(axis_) / axis_squared_);
   }
+  /// across(t).
+  const Eigen::Vector3d &acrossToT() const { return to_t_; }
   /// bendingAngle(p, q, t, s).
   double angleTo(const Eigen::Vector3d &s) const {
-    if (axis_squared_ == 0)
+    if (degenerate())
       return M_PI;
-    const Eigen::Vector3d to_s = (s - p_) - axis_ * ((s - p_).dot(axis_) / axis_squared_);
+    const Eigen::Vector3d to_s = across(s);
     // atan2 of |cross| and dot is accurate near 0 and pi, unlike acos.
     const double opening = std::atan2(to_t_.cross(to_s).norm(), to_t_.dot(to_s));
     return M_PI - opening;
   }
 
 private:
-  Eigen::Vector3d p_, axis_, to_t_;
+  Eigen::Vector3d p_, axis_;
   double axis_squared_;
+  Eigen::Vector3d to_t_;
 };
 
 /// Bending angle in [0, pi] between triangles (p, q, t) and (p, q, s) across
@@ -104,11 +94,13 @@ inline double bendingAngle(const Eigen::Vector3d &p, const Eigen::Vector3d &q,
 inline bool bendsSurelyLessThan(const Eigen::Vector3d &p, const Eigen::Vector3d &q,
                                 const Eigen::Vector3d &t, const Eigen::Vector3d &s,
                                 double limit_tan_squared) {
-  Eigen::Vector3d to_t, to_s;
-  if (!detail::acrossEdge(p, q, t, s, to_t, to_s))
+  const BendingAcrossEdge edge(p, q, t);
+  if (edge.degenerate())
     return false;
-  const double dot = to_t.dot(to_s);
-  return dot < 0 && to_t.cross(to_s).squaredNorm() < (1 - 1e-6) * limit_tan_squared * dot * dot;
+  const Eigen::Vector3d to_s = edge.across(s);
+  const double dot = edge.acrossToT().dot(to_s);
+  return dot < 0 &&
+         edge.acrossToT().cross(to_s).squaredNorm() < (1 - 1e-6) * limit_tan_squared * dot * dot;
 }
 
 /// Eq. 2: context cost that accepted neighbour T adds to candidate S across
