@@ -2,10 +2,10 @@
 // The twist repair's cut and the bow-tie split over a triangle list held in
 // parts (cuts_in_parts.h; docs/algorithm.md, "Finishing in parts").
 #include "cuts_in_parts.h"
-#include "sort_unique.h"
 
 #include "finish_steps.h"
 #include "process_bytes.h"
+#include "sort_unique.h"
 
 #include <algorithm>
 #include <iterator>

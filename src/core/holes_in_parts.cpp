@@ -2,12 +2,12 @@
 // Hole filling over a triangle list held in parts (holes_in_parts.h;
 // docs/algorithm.md, "Finishing in parts").
 #include "holes_in_parts.h"
-#include "sort_unique.h"
 
 #include "finish_steps.h"
 #include "numbering.h"
 #include "points_from_homes.h"
 #include "process_bytes.h"
+#include "sort_unique.h"
 
 #include <algorithm>
 #include <iterator>

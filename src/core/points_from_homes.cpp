@@ -2,6 +2,7 @@
 // Corner points from their homes (points_from_homes.h; docs/algorithm.md,
 // "Finishing in parts").
 #include "points_from_homes.h"
+
 #include "sort_unique.h"
 
 #include <algorithm>

@@ -2,10 +2,10 @@
 // Each orientable component's side over a triangle list held in parts
 // (sides_in_parts.h; docs/algorithm.md, "Finishing in parts").
 #include "sides_in_parts.h"
-#include "sort_unique.h"
 
 #include "exact_signs.h"
 #include "process_bytes.h"
+#include "sort_unique.h"
 
 #include <Eigen/Geometry>
 

@@ -2,11 +2,11 @@
 // The twist repair's spanning forest over a triangle list held in parts
 // (twists_in_parts.h; docs/algorithm.md, "Finishing in parts").
 #include "twists_in_parts.h"
-#include "sort_unique.h"
 
 #include "finish_steps.h"
 #include "pieces_in_parts.h"
 #include "process_bytes.h"
+#include "sort_unique.h"
 #include "twist_bending.h"
 
 #include <pcl_ms/costs.h>
