@@ -78,12 +78,15 @@ TEST(Costs, BendingAngleAcrossSharedEdge) {
   EXPECT_NEAR(bendingAngle(p, q, t, {0.7, -2, 0}), 0.0, 1e-12);     // flat continuation
   EXPECT_NEAR(bendingAngle(p, q, t, {0.1, 0.5, 0}), M_PI, 1e-12);   // folded back
   EXPECT_NEAR(bendingAngle(p, q, t, {0.5, 0, 3}), M_PI / 2, 1e-12); // right angle
-  // One edge, several triangles across it (the greedy's context): the
-  // same angles as one at a time.
+  // One edge object asked about several triangles in turn (the greedy's
+  // context): each angle is the one its position across the edge gives,
+  // whatever was asked before. Across this edge, t lies along +y; s at
+  // (.., 0.2, 0.9) is turned atan2(0.9, 0.2) away from t's side.
   const BendingAcrossEdge edge(p, q, t);
-  for (const Eigen::Vector3d &s :
-       {Eigen::Vector3d(0.7, -2, 0), Eigen::Vector3d(0.5, 0, 3), Eigen::Vector3d(-4, 0.2, 0.9)})
-    EXPECT_EQ(edge.angleTo(s), bendingAngle(p, q, t, s));
+  EXPECT_NEAR(edge.angleTo({0.7, -2, 0}), 0.0, 1e-12);
+  EXPECT_NEAR(edge.angleTo({0.5, 0, 3}), M_PI / 2, 1e-12);
+  EXPECT_NEAR(edge.angleTo({-4, 0.2, 0.9}), M_PI - std::atan2(0.9, 0.2), 1e-12);
+  EXPECT_NEAR(edge.angleTo({0.7, -2, 0}), 0.0, 1e-12);
   // An edge whose ends coincide bends by pi whatever the triangles.
   const BendingAcrossEdge degenerate(p, p, t);
   EXPECT_TRUE(degenerate.degenerate());
