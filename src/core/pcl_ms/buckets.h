@@ -19,7 +19,7 @@
 namespace pcl_ms {
 
 /// Target bucket size when Parameters::bucket_points is 0 (automatic).
-constexpr std::size_t default_bucket_points = 200000;
+constexpr std::size_t default_bucket_points = 100000;
 /// Clouds above this many distinct points are meshed in buckets by default.
 constexpr std::size_t automatic_bucketing_threshold = 600000;
 
