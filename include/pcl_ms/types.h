@@ -187,8 +187,10 @@ struct BucketStatistics {
   std::size_t seam_triangles = 0;            // triangles the seams added
   std::size_t failed_units = 0;              // buckets or zones left empty (e.g. collinear points)
   std::size_t bow_tie_triangles_removed = 0; // smaller fans where seams met
-  double buckets_seconds = 0;                // wall clock
-  double seams_seconds = 0;                  // wall clock
+  // Wall clock. In one process zones run beside the buckets: buckets_seconds
+  // ends with the last bucket, seams_seconds is what follows it.
+  double buckets_seconds = 0;
+  double seams_seconds = 0;
 };
 
 /// Wall-clock seconds per stage. In bucketed runs delaunay, scaffold and

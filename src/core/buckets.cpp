@@ -247,7 +247,13 @@ public:
     surface_.local_scale.assign(points_.size(), 0.0f);
     std::vector<BucketOutcome> leaf_outcomes(leaves.size());
     std::vector<std::size_t> margin_points(leaves.size(), 0);
-    if (UnitFarm *farm = exchange_.farm()) {
+    zone_figures_.assign(nodes.size(), ZoneFigures());
+    // One process meshes every unit once what it reads is final; shared
+    // among processes, the seams go level by level.
+    const bool as_ready = exchange_.farm() == nullptr && exchange_.processes() == 1;
+    if (as_ready) {
+      meshAsReady(leaf_outcomes, margin_points, progress);
+    } else if (UnitFarm *farm = exchange_.farm()) {
       // Only the units in flight keep their members.
       std::vector<std::vector<VertexIndex>> members(own_leaves.size());
       farm->mesh(
@@ -277,7 +283,7 @@ public:
     std::string first_error;
     for (std::size_t i : own_leaves) {
       const BucketOutcome &outcome = leaf_outcomes[i];
-      addTimings(outcome);
+      addLeafTimings(outcome);
       leaf_figures[3 * i] = outcome.error.empty() ? outcome.d_med : 0.0;
       leaf_figures[3 * i + 1] = outcome.error.empty() ? 0.0 : 1.0;
       leaf_figures[3 * i + 2] = static_cast<double>(margin_points[i]);
@@ -298,67 +304,23 @@ public:
     if (bucket_d_meds.empty())
       detail::throwNoBucketMeshed(first_error);
     surface_.d_med = detail::medianBucketDMed(std::move(bucket_d_meds));
-    surface_.statistics.buckets_seconds = secondsSince(stage);
+    // Meshed as ready, the seams' own time is what follows the last bucket.
+    surface_.statistics.buckets_seconds =
+        as_ready ? std::chrono::duration<double>(last_leaf_meshed_ - stage).count()
+                 : secondsSince(stage);
     exchange_.stageDone("buckets");
-
-    // Seams bottom-up: a zone's subtrees are complete when it is stitched,
-    // and zones of one depth are disjoint, so they run in parallel.
-    stage = Clock::now();
+    stage = as_ready ? last_leaf_meshed_ : Clock::now();
+    if (!as_ready)
+      stitchByLevels(inner, max_depth, progress);
     std::vector<double> seam_figures(3, 0.0); // points, triangles, failed units
-    for (int depth = max_depth; depth >= 0; --depth) {
-      std::vector<int> level;
-      std::vector<BucketExchange::Transfer> transfers;
-      for (int index : inner) {
-        if (nodes[index].depth != depth)
-          continue;
-        const int zone_owner = owner(nodes[index].first_leaf);
-        for (int child : nodes[index].children)
-          if (const int child_owner = owner(nodes[child].first_leaf); child_owner != zone_owner)
-            transfers.push_back({child_owner, zone_owner, &nodes[child].triangles});
-        if (zone_owner == exchange_.process())
-          level.push_back(index);
-      }
-      exchange_.moveTriangles(transfers);
-      std::vector<BucketOutcome> outcomes(level.size());
-      std::vector<std::size_t> zone_points(level.size(), 0);
-      if (UnitFarm *farm = exchange_.farm()) {
-        // Zones of one level are planned before any is stitched: planning
-        // reads only the zone's own subtree and the scales, fixed by now.
-        std::vector<Zone> zones(level.size());
-        std::vector<std::size_t> meshed;
-        for (std::size_t i = 0; i < level.size(); ++i) {
-          zones[i] = planZone(nodes[level[i]]);
-          if (zones[i].core_points >= 3)
-            meshed.push_back(i);
-        }
-        farm->mesh(
-            meshed.size(), [&](std::size_t k) { return std::move(zones[meshed[k]].task); },
-            [&](std::size_t k, BucketOutcome &&outcome) {
-              outcomes[meshed[k]] = std::move(outcome);
-            });
-        for (std::size_t i = 0; i < level.size(); ++i) {
-          zone_points[i] = keepZone(nodes[level[i]], zones[i], outcomes[i]);
-          progress.unitDone();
-        }
-      } else {
-        detail::withThreads(parameters_.num_threads, [&] {
-          detail::parallelFor(tbb::blocked_range<std::size_t>(0, level.size(), 1),
-                              [&](const tbb::blocked_range<std::size_t> &range) {
-                                for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                                  zone_points[i] = stitch(nodes[level[i]], outcomes[i]);
-                                  progress.unitDone();
-                                }
-                              });
-        });
-      }
-      for (std::size_t i = 0; i < level.size(); ++i) {
-        addTimings(outcomes[i]);
-        seam_figures[0] += static_cast<double>(zone_points[i]);
-        seam_figures[1] += static_cast<double>(outcomes[i].triangles.size());
-        if (!outcomes[i].error.empty() && zone_points[i] >= 3)
-          seam_figures[2] += 1;
-      }
-      exchange_.stageDone("seam level " + std::to_string(depth));
+    for (int index : inner) {
+      const ZoneFigures &zone = zone_figures_[static_cast<std::size_t>(index)];
+      surface_.delaunay_seconds += zone.delaunay_seconds;
+      surface_.scaffold_seconds += zone.scaffold_seconds;
+      surface_.greedy_seconds += zone.greedy_seconds;
+      seam_figures[0] += static_cast<double>(zone.core_points);
+      seam_figures[1] += static_cast<double>(zone.triangles);
+      seam_figures[2] += zone.failed ? 1 : 0;
     }
     std::vector<double> timings = {surface_.delaunay_seconds, surface_.scaffold_seconds,
                                    surface_.greedy_seconds};
@@ -391,6 +353,153 @@ public:
   }
 
 private:
+  /// What the statistics keep of a stitched zone.
+  struct ZoneFigures {
+    std::size_t core_points = 0, triangles = 0;
+    bool failed = false;
+    double delaunay_seconds = 0, scaffold_seconds = 0, greedy_seconds = 0;
+  };
+
+  /// Several processes: the seams bottom-up, a level at a time. A zone's
+  /// subtrees are complete when it is stitched, and zones of one depth are
+  /// disjoint, so they run in parallel.
+  void stitchByLevels(const std::vector<int> &inner, int max_depth, ProgressReporter &progress) {
+    std::vector<Node> &nodes = nodes_();
+    for (int depth = max_depth; depth >= 0; --depth) {
+      std::vector<int> level;
+      std::vector<BucketExchange::Transfer> transfers;
+      for (int index : inner) {
+        if (nodes[index].depth != depth)
+          continue;
+        const int zone_owner = owner(nodes[index].first_leaf);
+        for (int child : nodes[index].children)
+          if (const int child_owner = owner(nodes[child].first_leaf); child_owner != zone_owner)
+            transfers.push_back({child_owner, zone_owner, &nodes[child].triangles});
+        if (zone_owner == exchange_.process())
+          level.push_back(index);
+      }
+      exchange_.moveTriangles(transfers);
+      if (UnitFarm *farm = exchange_.farm()) {
+        // Zones of one level are planned before any is stitched: planning
+        // reads only the zone's own subtree and the scales, fixed by now.
+        std::vector<Zone> zones(level.size());
+        std::vector<std::size_t> meshed;
+        for (std::size_t i = 0; i < level.size(); ++i) {
+          zones[i] = planZone(nodes[level[i]], zonePoints(nodes[level[i]]));
+          if (zones[i].core_points >= 3)
+            meshed.push_back(i);
+        }
+        std::vector<BucketOutcome> outcomes(level.size());
+        farm->mesh(
+            meshed.size(), [&](std::size_t k) { return std::move(zones[meshed[k]].task); },
+            [&](std::size_t k, BucketOutcome &&outcome) {
+              outcomes[meshed[k]] = std::move(outcome);
+            });
+        for (std::size_t i = 0; i < level.size(); ++i) {
+          keepZone(level[i], zones[i], outcomes[i]);
+          progress.unitDone();
+        }
+      } else {
+        detail::withThreads(parameters_.num_threads, [&] {
+          detail::parallelFor(tbb::blocked_range<std::size_t>(0, level.size(), 1),
+                              [&](const tbb::blocked_range<std::size_t> &range) {
+                                for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                                  Node &node = nodes[level[i]];
+                                  stitch(level[i], planZone(node, zonePoints(node)));
+                                  progress.unitDone();
+                                }
+                              });
+        });
+      }
+      exchange_.stageDone("seam level " + std::to_string(depth));
+    }
+  }
+
+  /// One process: each bucket and zone as soon as what it reads is final
+  /// (docs/algorithm.md section 5, "Order of the units"). The buckets go in
+  /// their depth-first order; a zone is fed to the thread that finished the
+  /// last unit it waited for, so the seams fill the buckets' tail.
+  void meshAsReady(std::vector<BucketOutcome> &leaf_outcomes,
+                   std::vector<std::size_t> &margin_points, ProgressReporter &progress) {
+    std::vector<Node> &nodes = nodes_();
+    unfinished_children_.assign(nodes.size(), 0);
+    parent_.assign(nodes.size(), -1);
+    for (std::size_t i = 0; i < nodes.size(); ++i)
+      if (nodes[i].axis >= 0)
+        for (int child : nodes[i].children) {
+          parent_[static_cast<std::size_t>(child)] = static_cast<int>(i);
+          ++unfinished_children_[i];
+        }
+    leaf_meshed_.assign(tree_.leaves().size(), 0);
+    waiting_for_leaf_.assign(tree_.leaves().size(), {});
+    missing_leaves_.assign(nodes.size(), 0);
+    detail::withThreads(parameters_.num_threads, [&] {
+      detail::parallelForEachFed(tree_.leaves(), [&](int index, const auto &feed) {
+        Node &node = nodes[static_cast<std::size_t>(index)];
+        if (node.axis < 0) {
+          margin_points[node.first_leaf] = meshLeaf(node, leaf_outcomes[node.first_leaf]);
+        } else {
+          std::vector<VertexIndex> zone;
+          if (!scalesFinal(index, zone))
+            return; // fed again when the buckets it waits for are meshed
+          stitch(index, planZone(node, zone));
+        }
+        progress.unitDone();
+        for (int next : unitDone(index))
+          feed(next);
+      });
+    });
+  }
+
+  /// Whether every bucket owning a point of zone `index`'s slab has been
+  /// meshed, so the scales it reads are final; if so, `zone` gets its
+  /// points. If not, the zone waits for those buckets.
+  bool scalesFinal(int index, std::vector<VertexIndex> &zone) {
+    const Node &node = nodes_()[static_cast<std::size_t>(index)];
+    const std::vector<VertexIndex> near_plane = tree_.gather(zoneSlab(node, zoneMargin(node)));
+    if (!waitForLeaves(index, near_plane))
+      return false;
+    zone = zonePoints(node, near_plane);
+    return waitForLeaves(index, zone);
+  }
+
+  /// True when the buckets owning `points` are all meshed; otherwise zone
+  /// `index` is registered to be fed again once they are.
+  bool waitForLeaves(int index, const std::vector<VertexIndex> &points) {
+    std::vector<bool> needed(tree_.leaves().size(), false);
+    for (VertexIndex v : points)
+      needed[tree_.leafOf(v)] = true;
+    std::lock_guard<std::mutex> lock(ready_mutex_);
+    int missing = 0;
+    for (std::size_t leaf = 0; leaf < needed.size(); ++leaf)
+      if (needed[leaf] && !leaf_meshed_[leaf]) {
+        waiting_for_leaf_[leaf].push_back(index);
+        ++missing;
+      }
+    missing_leaves_[static_cast<std::size_t>(index)] = missing;
+    return missing == 0;
+  }
+
+  /// Marks unit `index` done; returns the zones it made ready.
+  std::vector<int> unitDone(int index) {
+    std::vector<int> ready;
+    std::lock_guard<std::mutex> lock(ready_mutex_);
+    const Node &node = nodes_()[static_cast<std::size_t>(index)];
+    if (node.axis < 0) {
+      leaf_meshed_[node.first_leaf] = 1;
+      last_leaf_meshed_ = std::max(last_leaf_meshed_, Clock::now());
+      for (int zone : waiting_for_leaf_[node.first_leaf])
+        if (--missing_leaves_[static_cast<std::size_t>(zone)] == 0)
+          ready.push_back(zone);
+      waiting_for_leaf_[node.first_leaf].clear();
+    }
+    // Last, so that its thread takes it first: the parent is on the way to
+    // the root, the longest chain.
+    const int parent = parent_[static_cast<std::size_t>(index)];
+    if (parent >= 0 && --unfinished_children_[static_cast<std::size_t>(parent)] == 0)
+      ready.push_back(parent);
+    return ready;
+  }
   BucketTask makeTask(const std::vector<VertexIndex> &members) const {
     BucketTask task;
     task.points.reserve(members.size());
@@ -430,6 +539,8 @@ private:
                        const std::vector<VertexIndex> &members) {
     const std::uint32_t leaf_id = leaf.first_leaf;
     leaf.triangles = toGlobal(outcome.triangles, members);
+    // Kept to the end, the buckets' own triangles would be a second surface.
+    std::vector<Triangle>().swap(outcome.triangles);
     markMayPinch(outcome.cut_vertices, members);
     // Each point's scale is the one its own bucket measured, where its
     // neighbourhood is complete; seams reuse it. Buckets own disjoint points.
@@ -457,17 +568,33 @@ private:
     BucketTask task;
   };
 
-  Zone planZone(Node &node) {
-    // The widest margin of the subtree's buckets.
-    const double margin = *std::max_element(leaf_margin_.begin() + node.first_leaf,
-                                            leaf_margin_.begin() + node.end_leaf);
-    auto slabOf = [&](double half_width) {
-      return detail::zoneSlab(node.region, node.axis, node.split, margin, half_width);
-    };
+  /// The widest margin of the subtree's buckets.
+  double zoneMargin(const Node &node) const {
+    return *std::max_element(leaf_margin_.begin() + node.first_leaf,
+                             leaf_margin_.begin() + node.end_leaf);
+  }
+
+  Box zoneSlab(const Node &node, double half_width) const {
+    return detail::zoneSlab(node.region, node.axis, node.split, zoneMargin(node), half_width);
+  }
+
+  /// The zone's points: those within rho times the largest scale among
+  /// `near_plane`, the points within the margin of its plane.
+  std::vector<VertexIndex> zonePoints(const Node &node,
+                                      const std::vector<VertexIndex> &near_plane) const {
     float largest_scale = 0;
-    for (VertexIndex v : tree_.gather(slabOf(margin)))
+    for (VertexIndex v : near_plane)
       largest_scale = std::max(largest_scale, surface_.local_scale[v]);
-    const std::vector<VertexIndex> zone = tree_.gather(slabOf(parameters_.rho * largest_scale));
+    return tree_.gather(zoneSlab(node, parameters_.rho * largest_scale));
+  }
+
+  std::vector<VertexIndex> zonePoints(const Node &node) const {
+    return zonePoints(node, tree_.gather(zoneSlab(node, zoneMargin(node))));
+  }
+
+  /// Plans the zone of `node` on its points `zone` (zonePoints): reads the
+  /// subtree's triangles and the points' scales.
+  Zone planZone(const Node &node, const std::vector<VertexIndex> &zone) {
     // Every triangle of the subtree is tested: a lookup table, not a search.
     std::vector<bool> in_zone(points_.size(), false);
     for (VertexIndex v : zone)
@@ -501,7 +628,8 @@ private:
 
     BucketTask &task = planned.task;
     task = makeTask(members);
-    task.d_med = surface_.d_med;
+    // No d_med given: a point without a scale (its bucket failed) takes the
+    // zone's own measure, known without waiting for every bucket.
     task.local_scale.reserve(members.size());
     for (VertexIndex v : members)
       task.local_scale.push_back(surface_.local_scale[v]);
@@ -524,18 +652,24 @@ private:
     return planned;
   }
 
-  /// The subtree's triangles, then the seam's, in a fixed order. Returns
-  /// the number of core points.
-  std::size_t keepZone(Node &node, const Zone &zone, BucketOutcome &outcome) {
+  /// The subtree's triangles, then the seam's, in a fixed order; and the
+  /// zone's figures.
+  void keepZone(int index, const Zone &zone, const BucketOutcome &outcome) {
+    Node &node = nodes_()[static_cast<std::size_t>(index)];
     std::vector<Triangle> added;
+    ZoneFigures &figures = zone_figures_[static_cast<std::size_t>(index)];
+    figures.core_points = zone.core_points;
     if (zone.core_points >= 3) {
       added = toGlobal(outcome.triangles, zone.members);
       markMayPinch(outcome.cut_vertices, zone.members);
       for (std::size_t i = 0; i < zone.members.size(); ++i)
         if (zone.core[i])
           may_pinch_[zone.members[i]] = 1;
-    } else {
-      outcome.error = "too few points";
+      figures.triangles = added.size();
+      figures.failed = !outcome.error.empty();
+      figures.delaunay_seconds = outcome.delaunay_seconds;
+      figures.scaffold_seconds = outcome.scaffold_seconds;
+      figures.greedy_seconds = outcome.greedy_seconds;
     }
     std::vector<Triangle> &merged = node.triangles;
     // Sized once: at the root this is the whole surface, and growing it by
@@ -548,7 +682,6 @@ private:
       std::vector<Triangle>().swap(part);
     }
     merged.insert(merged.end(), added.begin(), added.end());
-    return zone.core_points;
   }
 
   /// The zone along node's split plane: the subtree's points within reach
@@ -558,11 +691,11 @@ private:
   /// width; a sparse part's can exceed the buckets' margin.
   /// Triangles of the subtree that touch the core are fixed; their corners
   /// outside the zone are frozen. Returns the number of core points.
-  std::size_t stitch(Node &node, BucketOutcome &outcome) {
-    Zone zone = planZone(node);
+  void stitch(int index, const Zone &zone) {
+    BucketOutcome outcome;
     if (zone.core_points >= 3)
       outcome = meshBucket(zone.task, parameters_, deadline_);
-    return keepZone(node, zone, outcome);
+    keepZone(index, zone, outcome);
   }
 
   std::vector<Node> &nodes_() { return tree_.nodes(); }
@@ -578,7 +711,7 @@ private:
       may_pinch_[members[v]] = 1;
   }
 
-  void addTimings(const BucketOutcome &outcome) {
+  void addLeafTimings(const BucketOutcome &outcome) {
     surface_.delaunay_seconds += outcome.delaunay_seconds;
     surface_.scaffold_seconds += outcome.scaffold_seconds;
     surface_.greedy_seconds += outcome.greedy_seconds;
@@ -593,6 +726,13 @@ private:
   std::vector<double> leaf_margin_; // by leaf number
   BucketedSurface surface_;
   std::vector<std::uint8_t> may_pinch_ = std::vector<std::uint8_t>(points_.size(), 0);
+  std::vector<ZoneFigures> zone_figures_; // by node
+  // meshAsReady's schedule, under ready_mutex_: by node, then by leaf.
+  std::mutex ready_mutex_;
+  std::vector<int> parent_, unfinished_children_, missing_leaves_;
+  std::vector<std::uint8_t> leaf_meshed_;
+  std::vector<std::vector<int>> waiting_for_leaf_;
+  Clock::time_point last_leaf_meshed_;
 };
 
 } // namespace

@@ -653,7 +653,7 @@ private:
     std::merge(zone.begin(), zone.end(), frozen.begin(), frozen.end(), std::back_inserter(members),
                byIndex);
     BucketTask task = taskOf(members);
-    task.d_med = d_med_;
+    // No d_med, as in buckets.cpp: a point without a scale takes the zone's.
     task.local_scale.reserve(members.size());
     for (const PointRecord &member : members)
       task.local_scale.push_back(member.scale);

@@ -10,12 +10,14 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_for_each.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstddef>
+#include <vector>
 
 namespace pcl_ms {
 namespace detail {
@@ -61,6 +63,32 @@ template <typename Body> void parallelFor(std::size_t begin, std::size_t end, co
   } else {
     tbb::parallel_for(begin, end, body);
   }
+}
+
+/// Calls body(item, feed) for every item of `items` and every item passed to
+/// feed, in parallel unless on one thread; on one thread, in order, each
+/// fed item right after the call that fed it (on many threads fed items
+/// also come first on the thread that fed them). For work that makes more
+/// work ready as it goes; body must not wait for other items.
+template <typename Item, typename Body>
+void parallelForEachFed(const std::vector<Item> &items, const Body &body) {
+  if (onOneThread()) {
+    std::vector<Item> fed;
+    auto feed = [&](const Item &item) { fed.push_back(item); };
+    for (const Item &item : items) {
+      body(item, feed);
+      while (!fed.empty()) {
+        const Item next = fed.back();
+        fed.pop_back();
+        body(next, feed);
+      }
+    }
+    return;
+  }
+  tbb::parallel_for_each(items.begin(), items.end(),
+                         [&](const Item &item, tbb::feeder<Item> &feeder) {
+                           body(item, [&](const Item &next) { feeder.add(next); });
+                         });
 }
 
 /// join over body(subrange, identity) for subranges that cover `range`.

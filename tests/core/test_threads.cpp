@@ -95,6 +95,38 @@ TEST(Threads, SeveralThreadsCoverEveryIndexOnceAndNestedOneThreadRestores) {
   EXPECT_EQ(restored.load(), 20);
 }
 
+// Items fed while running (seam zones made ready by their buckets) run once
+// each; on one thread, each right after the call that fed it.
+TEST(Threads, FedItemsRunOnceAndOnOneThreadRightAfterTheirFeeder) {
+  // Item i < 100 feeds 100 + i when i is even; fed items feed nothing.
+  std::vector<int> items(100);
+  std::iota(items.begin(), items.end(), 0);
+  auto body = [](auto record) {
+    return [record](int item, const auto &feed) {
+      record(item);
+      if (item < 100 && item % 2 == 0)
+        feed(100 + item);
+    };
+  };
+  std::vector<int> order;
+  detail::withThreads(1, [&] {
+    detail::parallelForEachFed(items, body([&](int item) { order.push_back(item); }));
+  });
+  std::vector<int> expected;
+  for (int i = 0; i < 100; ++i) {
+    expected.push_back(i);
+    if (i % 2 == 0)
+      expected.push_back(100 + i);
+  }
+  EXPECT_EQ(order, expected);
+
+  std::vector<std::atomic<int>> runs(200);
+  detail::withThreads(
+      2, [&] { detail::parallelForEachFed(items, body([&](int item) { ++runs[item]; })); });
+  for (int i = 0; i < 200; ++i)
+    ASSERT_EQ(runs[i].load(), i < 100 || i % 2 == 0 ? 1 : 0) << i;
+}
+
 // Starting TBB cost 7 ms and 4 MB in a process with PCL loaded: a whole
 // one-thread reconstruction must not start it. ctest runs each test in its
 // own process, where TBB has not started before.
