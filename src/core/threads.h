@@ -66,10 +66,10 @@ template <typename Body> void parallelFor(std::size_t begin, std::size_t end, co
 }
 
 /// Calls body(item, feed) for every item of `items` and every item passed to
-/// feed, in parallel unless on one thread; on one thread, in order, each
-/// fed item right after the call that fed it (on many threads fed items
-/// also come first on the thread that fed them). For work that makes more
-/// work ready as it goes; body must not wait for other items.
+/// feed, in parallel unless on one thread; on one thread in order, each fed
+/// item right after the call that fed it (TBB too tends to run a fed item
+/// next on the thread that fed it). For work that makes more work ready as
+/// it goes; body must not wait for other items.
 template <typename Item, typename Body>
 void parallelForEachFed(const std::vector<Item> &items, const Body &body) {
   if (onOneThread()) {
