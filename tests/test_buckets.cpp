@@ -182,7 +182,7 @@ TEST(Buckets, SameMeshForOneTwoAndEightThreads) {
   }
 }
 
-// On one process each seam zone runs once the buckets it reads are meshed,
+// In one process each seam zone runs once the buckets it reads are meshed,
 // whichever thread gets there: the mesh is the one thread's, zone by zone.
 // Small enough for the thread sanitizer.
 TEST(Buckets, ZonesMeshedAsReadyGiveTheOneThreadMesh) {
