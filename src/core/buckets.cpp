@@ -456,7 +456,7 @@ private:
   /// points. If not, the zone waits for those buckets.
   bool scalesFinal(int index, std::vector<VertexIndex> &zone) {
     const Node &node = nodes_()[static_cast<std::size_t>(index)];
-    const std::vector<VertexIndex> near_plane = tree_.gather(zoneSlab(node, zoneMargin(node)));
+    const std::vector<VertexIndex> near_plane = nearPlane(node);
     if (!waitForLeaves(index, near_plane))
       return false;
     zone = zonePoints(node, near_plane);
@@ -487,7 +487,7 @@ private:
     const Node &node = nodes_()[static_cast<std::size_t>(index)];
     if (node.axis < 0) {
       leaf_meshed_[node.first_leaf] = 1;
-      last_leaf_meshed_ = std::max(last_leaf_meshed_, Clock::now());
+      last_leaf_meshed_ = Clock::now(); // under the lock: the latest wins
       for (int zone : waiting_for_leaf_[node.first_leaf])
         if (--missing_leaves_[static_cast<std::size_t>(zone)] == 0)
           ready.push_back(zone);
@@ -578,8 +578,17 @@ private:
     return detail::zoneSlab(node.region, node.axis, node.split, zoneMargin(node), half_width);
   }
 
-  /// The zone's points: those within rho times the largest scale among
-  /// `near_plane`, the points within the margin of its plane.
+  /// The points within the margin of node's split plane.
+  std::vector<VertexIndex> nearPlane(const Node &node) const {
+    return tree_.gather(zoneSlab(node, zoneMargin(node)));
+  }
+
+  /// The zone along node's split plane: the points within rho times the
+  /// largest scale among `near_plane` (nearPlane). A triangle across the
+  /// plane is shorter than that, so it is the zone's half width; a sparse
+  /// part's can exceed the buckets' margin. Those of the subtree are its
+  /// core; the others, of neighbouring subtrees, lie within the margin
+  /// around the node's region.
   std::vector<VertexIndex> zonePoints(const Node &node,
                                       const std::vector<VertexIndex> &near_plane) const {
     float largest_scale = 0;
@@ -589,11 +598,12 @@ private:
   }
 
   std::vector<VertexIndex> zonePoints(const Node &node) const {
-    return zonePoints(node, tree_.gather(zoneSlab(node, zoneMargin(node))));
+    return zonePoints(node, nearPlane(node));
   }
 
   /// Plans the zone of `node` on its points `zone` (zonePoints): reads the
-  /// subtree's triangles and the points' scales.
+  /// subtree's triangles and the points' scales. Triangles of the subtree
+  /// that touch the zone are fixed; their corners outside it are frozen.
   Zone planZone(const Node &node, const std::vector<VertexIndex> &zone) {
     // Every triangle of the subtree is tested: a lookup table, not a search.
     std::vector<bool> in_zone(points_.size(), false);
@@ -684,13 +694,8 @@ private:
     merged.insert(merged.end(), added.begin(), added.end());
   }
 
-  /// The zone along node's split plane: the subtree's points within reach
-  /// of the plane (core), and points of other subtrees within the margin
-  /// around the node's region. A triangle across the plane is shorter than
-  /// rho times the largest local scale near it, so that is the zone's half
-  /// width; a sparse part's can exceed the buckets' margin.
-  /// Triangles of the subtree that touch the core are fixed; their corners
-  /// outside the zone are frozen. Returns the number of core points.
+  /// Meshes a planned zone (with fewer than 3 core points, nothing) and
+  /// keeps its triangles with the subtree's.
   void stitch(int index, const Zone &zone) {
     BucketOutcome outcome;
     if (zone.core_points >= 3)
