@@ -136,6 +136,6 @@ int run(int argc, char **argv) {
 } // namespace
 
 int main(int argc, char **argv) {
-  pcl_ms_tools::restartWithHugePageHeap(argv);
+  pcl_ms_tools::restartWithHugePageHeap(argv, pcl_ms_tools::HugePageHeap::kOnRequest);
   return pcl_ms_tools::runGuarded(run, argc, argv, pcl_ms_tools::kReconstructionFailure);
 }

@@ -673,7 +673,7 @@ int run(const Job &job, int argc, char **argv) {
 } // namespace
 
 int main(int argc, char **argv) {
-  pcl_ms_tools::restartWithHugePageHeap(argv);
+  pcl_ms_tools::restartWithHugePageHeap(argv, pcl_ms_tools::HugePageHeap::kByDefault);
 #ifdef __GLIBC__
   // Blocks of 1 MB and more (unit messages, per-bucket triangles) are
   // mapped and returned on free. Left to glibc's adaptive threshold they

@@ -13,7 +13,11 @@
 int main(int, char **argv) {
   std::printf("started %ld\n", static_cast<long>(getpid()));
   std::fflush(stdout); // a restart replaces the buffer
-  pcl_ms_tools::restartWithHugePageHeap(argv);
+  // As pcl_ms_reconstruct does with PROBE_ON_REQUEST set, else as the MPI
+  // tool does.
+  pcl_ms_tools::restartWithHugePageHeap(argv, std::getenv("PROBE_ON_REQUEST") != nullptr
+                                                  ? pcl_ms_tools::HugePageHeap::kOnRequest
+                                                  : pcl_ms_tools::HugePageHeap::kByDefault);
   const char *tunables = std::getenv("GLIBC_TUNABLES");
   const char *choice = std::getenv("PCL_MS_HUGE_PAGES");
   std::printf("tunables [%s]\nchoice [%s]\npid %ld\n", tunables ? tunables : "",

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The reconstruct tools' restart onto a huge-page heap (huge_page_heap.h),
-// through a probe program that restarts the same way.
+// through a probe program that restarts the same way: by default (the MPI
+// tool) or on request (pcl_ms_reconstruct).
 #include "program_test.h"
 
 #include <gtest/gtest.h>
@@ -69,10 +70,22 @@ TEST_F(HugePageHeap, KeepsTheUsersTunables) {
       << stdout_;
 }
 
+TEST_F(HugePageHeap, OnRequestRestartsOnlyWhenAskedTo) {
+  runProbe("PROBE_ON_REQUEST=1");
+  EXPECT_EQ(starts_, 1);
+  EXPECT_TRUE(contains(stdout_, "tunables []\nchoice []\n")) << stdout_;
+  runProbe("PROBE_ON_REQUEST=1 PCL_MS_HUGE_PAGES=1");
+  if (!hugePagesOnAdvice())
+    GTEST_SKIP() << "transparent huge pages are not on advice here";
+  EXPECT_EQ(starts_, 2);
+  EXPECT_TRUE(contains(stdout_, "tunables [glibc.malloc.hugetlb=1]\nchoice [1]\n")) << stdout_;
+}
+
 TEST_F(HugePageHeap, StaysAsStartedWhenTheUserChoseOrUnderValgrind) {
   for (const std::string environment :
        {"PCL_MS_HUGE_PAGES=0", "GLIBC_TUNABLES=glibc.malloc.hugetlb=0",
-        "LD_PRELOAD=/nonexistent/vgpreload_core-amd64-linux.so"}) {
+        "LD_PRELOAD=/nonexistent/vgpreload_core-amd64-linux.so",
+        "PROBE_ON_REQUEST=1 PCL_MS_HUGE_PAGES=1 GLIBC_TUNABLES=glibc.malloc.hugetlb=0"}) {
     runProbe(environment);
     EXPECT_EQ(starts_, 1) << environment;
     EXPECT_FALSE(contains(stdout_, "hugetlb=1")) << environment << "\n" << stdout_;

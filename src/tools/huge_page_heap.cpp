@@ -36,10 +36,21 @@ bool contains(const char *text, const char *part) {
   return text != nullptr && std::strstr(text, part) != nullptr;
 }
 
+/// PCL_MS_HUGE_PAGES: "0" no, "1" yes, unset (or anything else) `when`'s
+/// default.
+bool wanted(HugePageHeap when) {
+  const char *choice = std::getenv(kChoice);
+  if (choice != nullptr && std::strcmp(choice, "0") == 0)
+    return false;
+  if (choice != nullptr && std::strcmp(choice, "1") == 0)
+    return true;
+  return when == HugePageHeap::kByDefault;
+}
+
 } // namespace
 
-void restartWithHugePageHeap(char **argv) {
-  if (std::getenv(kChoice) != nullptr || contains(std::getenv("GLIBC_TUNABLES"), kTunable) ||
+void restartWithHugePageHeap(char **argv, HugePageHeap when) {
+  if (!wanted(when) || contains(std::getenv("GLIBC_TUNABLES"), kTunable) ||
       contains(std::getenv("LD_PRELOAD"), "vgpreload") || !hugePagesOnAdvice())
     return;
   const char *given = std::getenv("GLIBC_TUNABLES");
@@ -58,7 +69,7 @@ void restartWithHugePageHeap(char **argv) {
 
 namespace pcl_ms_tools {
 
-void restartWithHugePageHeap(char **) {}
+void restartWithHugePageHeap(char **, HugePageHeap) {}
 
 } // namespace pcl_ms_tools
 
