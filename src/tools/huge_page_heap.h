@@ -11,11 +11,11 @@ enum class HugePageHeap {
   /// Unless PCL_MS_HUGE_PAGES=0: the MPI tool, whose exchanges fill fresh
   /// buffers of hundreds of megabytes.
   kByDefault,
-  /// Only with PCL_MS_HUGE_PAGES=1: one process, whose arrays are fewer
-  /// and reused; where fresh huge pages are slow to fault in (virtual
-  /// machines that hand freed memory back to their host) the heap on huge
-  /// pages made a one-piece run slower, and the restart costs a program
-  /// start (bench/README.md, "The one-process tool's heap").
+  /// Only with PCL_MS_HUGE_PAGES=1: pcl_ms_reconstruct. Where fresh huge
+  /// pages are slow to fault in (a virtual machine whose host backs them
+  /// on first touch), the heap on huge pages made its one-piece runs slower
+  /// and its bucketed runs no faster, and the restart costs a program start
+  /// (bench/README.md, "The one-process tool's heap").
   kOnRequest,
 };
 
