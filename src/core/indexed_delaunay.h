@@ -11,10 +11,15 @@
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Delaunay_triangulation_cell_base_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Spatial_sort_traits_adapter_3.h>
 #include <CGAL/Triangulation_cell_base_with_info_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
+#include <CGAL/property_map.h>
+#include <CGAL/spatial_sort.h>
 
 #include <cstdint>
+#include <utility>
+#include <vector>
 
 namespace pcl_ms {
 namespace detail {
@@ -29,6 +34,27 @@ using DataStructure = CGAL::Triangulation_data_structure_3<VertexBase, CellBase>
 using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, DataStructure>;
 using CellHandle = Delaunay::Cell_handle;
 using VertexHandle = Delaunay::Vertex_handle;
+using IndexedPoint = std::pair<KernelPoint, VertexIndex>;
+
+/// Inserts the points of `input`, each vertex holding its index, in the
+/// order CGAL's range insertion uses: its spatial sort, applied to the pairs
+/// themselves. CGAL's own insertion of pairs sorts indices into a copy of the
+/// points instead, whose scattered reads made the triangulation 4-7 % slower
+/// than one of bare points; the sort moves the same positions either way, so
+/// the triangulation is the same (docs/algorithm.md, "The triangulation's
+/// insertion").
+/// Reorders `input`.
+inline void insertIndexed(Delaunay &delaunay, std::vector<IndexedPoint> &input) {
+  using SortTraits =
+      CGAL::Spatial_sort_traits_adapter_3<Kernel, CGAL::First_of_pair_property_map<IndexedPoint>>;
+  CGAL::spatial_sort(input.begin(), input.end(), SortTraits());
+  VertexHandle hint;
+  for (const auto &[point, index] : input) {
+    hint = delaunay.insert(point, hint);
+    if (hint != VertexHandle())
+      hint->info() = index;
+  }
+}
 
 } // namespace detail
 } // namespace pcl_ms

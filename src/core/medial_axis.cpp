@@ -168,13 +168,13 @@ private:
   }
 
   void triangulate() {
-    std::vector<std::pair<KernelPoint, VertexIndex>> input;
+    std::vector<detail::IndexedPoint> input;
     input.reserve(distinct_.size());
     for (VertexIndex p : distinct_)
       input.emplace_back(KernelPoint(points_[p].x(), points_[p].y(), points_[p].z()), p);
     // The points go in in coordinate order and CGAL's symbolic perturbation
     // is by coordinates too: the same point set gives the same tetrahedra.
-    delaunay_.insert(input.begin(), input.end());
+    detail::insertIndexed(delaunay_, input);
     vertex_of_point_.assign(points_.size(), VertexHandle());
     for (VertexHandle vertex : delaunay_.finite_vertex_handles())
       vertex_of_point_[vertex->info()] = vertex;

@@ -261,14 +261,16 @@ public:
 
 private:
   Delaunay triangulate() const {
-    std::vector<std::pair<KernelPoint, VertexIndex>> input;
+    std::vector<detail::IndexedPoint> input;
     input.reserve(points_.size());
     for (std::size_t i = 0; i < points_.size(); ++i)
       input.emplace_back(KernelPoint(points_[i].x(), points_[i].y(), points_[i].z()),
                          static_cast<VertexIndex>(i));
-    // Range insertion sorts spatially; symbolic perturbation makes the
+    // Inserted in spatial order; symbolic perturbation makes the
     // triangulation unique even for co-spherical points.
-    return Delaunay(input.begin(), input.end());
+    Delaunay delaunay;
+    detail::insertIndexed(delaunay, input);
+    return delaunay;
   }
 
   /// Numbers the cells (ids decide which of two cells owns a shared facet)
