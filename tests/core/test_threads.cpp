@@ -145,7 +145,7 @@ TEST(Threads, FedItemsRunOnceAndOnOneThreadRightAfterTheirFeeder) {
 // (a bucket's figures read after every seam is meshed): the loops must tell
 // TSan that TBB ordered them, or the sanitizer job (which runs this test)
 // reports a race that its suppression for TBB cannot match.
-TEST(Threads, TasksWritesAreOrderedBeforeTheCallerAfterTheLoop) {
+TEST(Threads, TaskWritesAreOrderedBeforeTheCallerAfterTheLoop) {
   const std::size_t items = 8;
   std::vector<std::vector<std::uint64_t>> scratch(5 * items);
   std::vector<std::size_t> by_index(items), by_range(items), fed(2 * items), reduced(items);
