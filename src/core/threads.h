@@ -51,6 +51,41 @@ public:
 #endif
 };
 
+/// The hand-offs of one parallel loop, made before it starts: the caller's
+/// writes so far go to every task, and when it goes out of scope, after the
+/// loop, every task's writes come back to the caller.
+class LoopOrder {
+public:
+  /// Held by a task for as long as it runs: it starts after the caller's
+  /// writes and after every feed so far, and hands its writes back.
+  class Task {
+  public:
+    explicit Task(LoopOrder &order) : order_(order) {
+      order_.start_.acquire();
+      order_.fed_.acquire();
+    }
+    ~Task() { order_.done_.release(); }
+    Task(const Task &) = delete;
+    Task &operator=(const Task &) = delete;
+
+  private:
+    LoopOrder &order_;
+  };
+
+  LoopOrder() { start_.release(); }
+  ~LoopOrder() { done_.acquire(); }
+  LoopOrder(const LoopOrder &) = delete;
+  LoopOrder &operator=(const LoopOrder &) = delete;
+
+  /// Before a task feeds an item: the item starts after what it wrote.
+  void feeding() { fed_.release(); }
+  /// Before a join: it reads the values of the tasks it joins.
+  void joining() { done_.acquire(); }
+
+private:
+  HandOff start_, fed_, done_;
+};
+
 /// Whether the calling thread runs work limited to one thread (see
 /// withThreads): the loops below then run on it, in order.
 inline bool &onOneThread() {
@@ -70,18 +105,9 @@ template <typename Work> decltype(auto) withThreads(int num_threads, Work &&work
   if (num_threads == 1)
     return work();
   tbb::task_arena arena(num_threads > 0 ? num_threads : tbb::task_arena::automatic);
-  HandOff enter, leave;
-  struct AcquireOnReturn {
-    HandOff &leave;
-    ~AcquireOnReturn() { leave.acquire(); }
-  } acquire_on_return{leave};
-  enter.release();
+  LoopOrder order;
   return arena.execute([&]() -> decltype(auto) {
-    enter.acquire();
-    struct ReleaseOnReturn {
-      HandOff &leave;
-      ~ReleaseOnReturn() { leave.release(); }
-    } release_on_return{leave};
+    const LoopOrder::Task task(order);
     return work();
   });
 }
@@ -95,14 +121,11 @@ void parallelFor(const tbb::blocked_range<std::size_t> &range, const Body &body)
     body(range);
     return;
   }
-  HandOff start, done;
-  start.release();
+  LoopOrder order;
   tbb::parallel_for(range, [&](const tbb::blocked_range<std::size_t> &part) {
-    start.acquire();
+    const LoopOrder::Task task(order);
     body(part);
-    done.release();
   });
-  done.acquire();
 }
 
 /// Calls body(i) for every i in [begin, end), as parallelFor above.
@@ -112,14 +135,11 @@ template <typename Body> void parallelFor(std::size_t begin, std::size_t end, co
       body(i);
     return;
   }
-  HandOff start, done;
-  start.release();
+  LoopOrder order;
   tbb::parallel_for(begin, end, [&](std::size_t i) {
-    start.acquire();
+    const LoopOrder::Task task(order);
     body(i);
-    done.release();
   });
-  done.acquire();
 }
 
 /// Calls body(item, feed) for every item of `items` and every item passed to
@@ -142,20 +162,15 @@ void parallelForEachFed(const std::vector<Item> &items, const Body &body) {
     }
     return;
   }
-  // An item fed by a task starts after what that task wrote before feeding.
-  HandOff start, fed, done;
-  start.release();
+  LoopOrder order;
   tbb::parallel_for_each(items.begin(), items.end(),
                          [&](const Item &item, tbb::feeder<Item> &feeder) {
-                           start.acquire();
-                           fed.acquire();
+                           const LoopOrder::Task task(order);
                            body(item, [&](const Item &next) {
-                             fed.release();
+                             order.feeding();
                              feeder.add(next);
                            });
-                           done.release();
                          });
-  done.acquire();
 }
 
 /// join over body(subrange, identity) for subranges that cover `range`.
@@ -164,25 +179,18 @@ Value parallelReduce(const tbb::blocked_range<std::size_t> &range, const Value &
                      const Body &body, const Join &join) {
   if (onOneThread())
     return body(range, identity);
-  // A join reads the values of the parts it joins.
-  HandOff start, done;
-  start.release();
-  Value result = tbb::parallel_reduce(
+  LoopOrder order;
+  return tbb::parallel_reduce(
       range, identity,
-      [&](const tbb::blocked_range<std::size_t> &part, const Value &value) {
-        start.acquire();
-        Value partial = body(part, value);
-        done.release();
-        return partial;
+      [&](const tbb::blocked_range<std::size_t> &part, const Value &value) -> Value {
+        const LoopOrder::Task task(order);
+        return body(part, value);
       },
-      [&](const Value &left, const Value &right) {
-        done.acquire();
-        Value joined = join(left, right);
-        done.release();
-        return joined;
+      [&](const Value &left, const Value &right) -> Value {
+        order.joining();
+        const LoopOrder::Task task(order);
+        return join(left, right);
       });
-  done.acquire();
-  return result;
 }
 
 /// Sorts [first, last) by `less`, which must order every pair of distinct
