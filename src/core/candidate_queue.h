@@ -84,6 +84,11 @@ public:
     return next_ + steps < sorted_.size() ? &sorted_[next_ + steps] : nullptr;
   }
 
+  /// The heap's cheapest entry, if any, arrivals not counted: the pass
+  /// fetches its data while deciding the current candidate, as it may well
+  /// be the next one popped.
+  const QueueEntry *heapTop() const { return heap_.empty() ? nullptr : &heap_.top(); }
+
   /// Drops the outdated entries.
   template <typename IsCurrent> void compact(const IsCurrent &is_current) {
     settleArrivals();

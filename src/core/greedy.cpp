@@ -8,6 +8,7 @@
 #include <pcl_ms/costs.h>
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
 
@@ -165,17 +166,42 @@ double GreedyMesher::Impl::contextTerm(CandidateIndex from, int k, CandidateInde
 /// every candidate sharing one of its edges, accepted ones included: their
 /// current cost is what error recovery compares against.
 void GreedyMesher::Impl::propagateContext(CandidateIndex t, double sign) {
+  // The neighbours' records and apexes lie all over memory: listing them and
+  // fetching each as it is listed, before any is computed, overlaps their
+  // cache misses (docs/algorithm.md, section 3).
+  const Candidate &accepted = candidates_[t];
+  std::array<std::size_t, 4> first_on_edge{};
+  neighbours_.clear();
   for (int k = 0; k < 3; ++k) {
-    const ContextAcross across(*this, t, k);
-    forEachCandidateOn(candidates_[t].edges[k], [&](CandidateIndex s) {
-      // Dropped candidates never return; waiting Q2 members get their
-      // context recomputed when Q2 is built.
-      if (s == t || states_[s].state == State::dropped || isWaitingForQueue2(s))
-        return false;
-      states_[s].context += sign * across.termFor(s);
-      refreshCost(s);
+    first_on_edge[k] = neighbours_.size();
+    forEachCandidateOn(accepted.edges[k], [&](CandidateIndex s) {
+      if (s != t) {
+        __builtin_prefetch(&states_[s]);
+        __builtin_prefetch(&candidates_[s]);
+        neighbours_.push_back({s, 0});
+      }
       return false;
     });
+  }
+  first_on_edge[3] = neighbours_.size();
+  for (int k = 0; k < 3; ++k)
+    for (std::size_t i = first_on_edge[k]; i < first_on_edge[k + 1]; ++i) {
+      Neighbour &neighbour = neighbours_[i];
+      neighbour.apex =
+          apexOf(neighbour.candidate, accepted.vertices[k], accepted.vertices[(k + 1) % 3]);
+      __builtin_prefetch(&points_[neighbour.apex]);
+    }
+  for (int k = 0; k < 3; ++k) {
+    const ContextAcross across(*this, t, k);
+    for (std::size_t i = first_on_edge[k]; i < first_on_edge[k + 1]; ++i) {
+      const CandidateIndex s = neighbours_[i].candidate;
+      // Dropped candidates never return; waiting Q2 members get their
+      // context recomputed when Q2 is built.
+      if (states_[s].state == State::dropped || isWaitingForQueue2(s))
+        continue;
+      states_[s].context += sign * across.termFor(s, neighbours_[i].apex);
+      refreshCost(s);
+    }
   }
 }
 
@@ -255,6 +281,10 @@ void GreedyMesher::Impl::runPass(State queue_state, PassStatistics &statistics) 
       __builtin_prefetch(&states_[ahead->candidate()]);
       __builtin_prefetch(&candidates_[ahead->candidate()]);
     }
+    if (const QueueEntry *next = queue.heapTop()) {
+      __builtin_prefetch(&states_[next->candidate()]);
+      __builtin_prefetch(&candidates_[next->candidate()]);
+    }
     if (!isLive(entry, queue_state))
       continue;
     const CandidateIndex t = entry.candidate();
@@ -268,6 +298,8 @@ void GreedyMesher::Impl::runPass(State queue_state, PassStatistics &statistics) 
     states_[t].state = State::idle;
     ++statistics.popped;
     decide(t, queue_state, statistics);
+    if (const QueueEntry *next = queue.heapTop())
+      mesh_.prefetchAround(next->candidate());
   }
 }
 

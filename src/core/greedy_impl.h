@@ -79,13 +79,10 @@ private:
           bending_(greedy.points_[p_], greedy.points_[q_],
                    greedy.points_[greedy.candidates_[from].vertices[(k + 2) % 3]]) {}
     /// eps2 it adds to candidate `to`, on the same edge.
-    double termFor(CandidateIndex to) const {
-      const Candidate &target = greedy_.candidates_[to];
-      VertexIndex apex = target.vertices[0];
-      for (VertexIndex v : target.vertices)
-        if (v != p_ && v != q_)
-          apex = v;
-      return contextCost(edge_length_, target.inverse_shock_compactness,
+    double termFor(CandidateIndex to) const { return termFor(to, greedy_.apexOf(to, p_, q_)); }
+    /// The same, given the candidate's vertex off the edge.
+    double termFor(CandidateIndex to, VertexIndex apex) const {
+      return contextCost(edge_length_, greedy_.candidates_[to].inverse_shock_compactness,
                          bending_.angleTo(greedy_.points_[apex]));
     }
 
@@ -240,6 +237,13 @@ private:
   std::vector<bool> multi_fan_vertex_;
   std::vector<bool> may_have_several_fans_;
   std::vector<double> delay_multiplier_;
+  // The candidates on an accepted triangle's edges and their apexes, listed
+  // by propagateContext before it computes any (kept to spare allocations).
+  struct Neighbour {
+    CandidateIndex candidate;
+    VertexIndex apex;
+  };
+  std::vector<Neighbour> neighbours_;
   // Seam pass: its triangles in order, per edge, and flags.
   std::vector<CandidateIndex> seam_list_;
   std::unordered_map<EdgeIndex, std::vector<CandidateIndex>> seam_on_edge_;
