@@ -16,6 +16,7 @@
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 #include <CGAL/property_map.h>
 #include <CGAL/spatial_sort.h>
+#include <Eigen/Core>
 
 #include <cstdint>
 #include <utility>
@@ -35,6 +36,24 @@ using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, DataStructure>;
 using CellHandle = Delaunay::Cell_handle;
 using VertexHandle = Delaunay::Vertex_handle;
 using IndexedPoint = std::pair<KernelPoint, VertexIndex>;
+
+/// (points[i], i) for every i of `chosen`, in that order: insertIndexed's input.
+inline std::vector<IndexedPoint> indexedPoints(const std::vector<Eigen::Vector3d> &points,
+                                               const std::vector<VertexIndex> &chosen) {
+  std::vector<IndexedPoint> input;
+  input.reserve(chosen.size());
+  for (VertexIndex i : chosen)
+    input.emplace_back(KernelPoint(points[i].x(), points[i].y(), points[i].z()), i);
+  return input;
+}
+
+/// (points[i], i) for every point.
+inline std::vector<IndexedPoint> indexedPoints(const std::vector<Eigen::Vector3d> &points) {
+  std::vector<VertexIndex> all(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    all[i] = static_cast<VertexIndex>(i);
+  return indexedPoints(points, all);
+}
 
 /// Inserts the points of `input`, each vertex holding its index, in the
 /// order CGAL's range insertion uses: its spatial sort, applied to the pairs

@@ -168,10 +168,7 @@ private:
   }
 
   void triangulate() {
-    std::vector<detail::IndexedPoint> input;
-    input.reserve(distinct_.size());
-    for (VertexIndex p : distinct_)
-      input.emplace_back(KernelPoint(points_[p].x(), points_[p].y(), points_[p].z()), p);
+    std::vector<detail::IndexedPoint> input = detail::indexedPoints(points_, distinct_);
     // The points go in in coordinate order and CGAL's symbolic perturbation
     // is by coordinates too: the same point set gives the same tetrahedra.
     detail::insertIndexed(delaunay_, input);

@@ -261,11 +261,7 @@ public:
 
 private:
   Delaunay triangulate() const {
-    std::vector<detail::IndexedPoint> input;
-    input.reserve(points_.size());
-    for (std::size_t i = 0; i < points_.size(); ++i)
-      input.emplace_back(KernelPoint(points_[i].x(), points_[i].y(), points_[i].z()),
-                         static_cast<VertexIndex>(i));
+    std::vector<detail::IndexedPoint> input = detail::indexedPoints(points_);
     // Inserted in spatial order; symbolic perturbation makes the
     // triangulation unique even for co-spherical points.
     Delaunay delaunay;

@@ -17,14 +17,6 @@ using detail::KernelPoint;
 
 namespace {
 
-std::vector<IndexedPoint> indexed(const std::vector<Eigen::Vector3d> &points) {
-  std::vector<IndexedPoint> input;
-  for (std::size_t i = 0; i < points.size(); ++i)
-    input.emplace_back(KernelPoint(points[i].x(), points[i].y(), points[i].z()),
-                       static_cast<VertexIndex>(i));
-  return input;
-}
-
 /// Each cell's corners as point indices (the infinite vertex as -1), in the
 /// order the cell store lists the cells: what the scaffold reads, in its order.
 std::vector<std::int64_t> cellCorners(const Delaunay &delaunay) {
@@ -38,7 +30,7 @@ std::vector<std::int64_t> cellCorners(const Delaunay &delaunay) {
 /// insertIndexed gives CGAL's triangulation, cell for cell, and each vertex
 /// holds the index of its own point.
 void expectSameAsCgal(const std::vector<Eigen::Vector3d> &points) {
-  std::vector<IndexedPoint> input = indexed(points);
+  std::vector<IndexedPoint> input = detail::indexedPoints(points);
   const Delaunay reference(input.begin(), input.end());
   Delaunay ours;
   detail::insertIndexed(ours, input);
@@ -87,4 +79,18 @@ TEST(IndexedDelaunay, RandomCloudsOfEverySizeGiveCgalsTriangulation) {
       p = Eigen::Vector3d(coordinate(random), coordinate(random), coordinate(random));
     expectSameAsCgal(points);
   }
+}
+
+TEST(IndexedDelaunay, ChosenPointsKeepTheirOwnIndices) {
+  const std::vector<Eigen::Vector3d> points =
+      pcl_ms_test::positions(pcl_ms_test::fibonacciSphere(50));
+  const std::vector<VertexIndex> chosen = {7, 3, 49, 0, 21};
+  const std::vector<IndexedPoint> input = detail::indexedPoints(points, chosen);
+  ASSERT_EQ(input.size(), chosen.size());
+  for (std::size_t k = 0; k < chosen.size(); ++k) {
+    EXPECT_EQ(input[k].second, chosen[k]);
+    const Eigen::Vector3d &p = points[chosen[k]];
+    EXPECT_EQ(input[k].first, KernelPoint(p.x(), p.y(), p.z()));
+  }
+  EXPECT_TRUE(detail::indexedPoints(points, {}).empty());
 }
