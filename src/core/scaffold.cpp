@@ -144,18 +144,39 @@ std::optional<Circle> circumcircle(const Eigen::Vector3d &a, const EdgeVectors &
   return circle;
 }
 
+// The cloud's points are in the user's order, not the cells': the candidate
+// loop fetches the corner points of the cell this many steps ahead, whose
+// vertices prefetchNeighbours has fetched by then.
+constexpr std::size_t corner_prefetch_distance = 4;
+
 // Cells are visited in memory order, but their neighbours, which every
 // facet test reads, lie anywhere: fetching the neighbours of the cell this
 // many steps ahead hides most of the wait for them.
 constexpr std::size_t neighbour_prefetch_distance = 8;
 
-void prefetchNeighbours(const std::vector<CellHandle> &cells, std::size_t index) {
+// Inlined by force, like every helper that only prefetches: GCC takes such a
+// function for one without effects and drops the calls to it.
+[[gnu::always_inline]] inline void prefetchNeighbours(const std::vector<CellHandle> &cells,
+                                                      std::size_t index) {
   if (index >= cells.size())
     return;
   for (int i = 0; i < 4; ++i) {
     const char *neighbour = reinterpret_cast<const char *>(&*cells[index]->neighbor(i));
     __builtin_prefetch(neighbour);
     __builtin_prefetch(neighbour + 64);
+    __builtin_prefetch(&*cells[index]->vertex(i));
+  }
+}
+
+[[gnu::always_inline]] inline void
+prefetchCornerPoints(const std::vector<CellHandle> &cells, std::size_t index,
+                     VertexHandle infinite_vertex, const std::vector<Eigen::Vector3d> &points) {
+  if (index >= cells.size())
+    return;
+  for (int i = 0; i < 4; ++i) {
+    const VertexHandle vertex = cells[index]->vertex(i);
+    if (vertex != infinite_vertex)
+      __builtin_prefetch(&points[vertex->info()]);
   }
 }
 
@@ -530,8 +551,11 @@ private:
           std::vector<FacetKind>::const_iterator kind = chunk_kinds_[chunk].begin();
           out.candidates.reserve(chunk_kinds_[chunk].size());
           for (std::size_t index = begin; index < end; ++index) {
-            if (!scaffold_.planar)
+            if (!scaffold_.planar) {
               prefetchNeighbours(cells_, index + neighbour_prefetch_distance);
+              prefetchCornerPoints(cells_, index + corner_prefetch_distance,
+                                   delaunay.infinite_vertex(), points_);
+            }
             forEachOwnedFacet(
                 delaunay, cells_[index],
                 [&](CellHandle cell, int i, const std::array<VertexHandle, 3> &handles) {
