@@ -59,6 +59,21 @@ public:
     return false;
   }
 
+  /// Asks the processor for where the scaffold's lists of candidate t's
+  /// edges start (step 1) or for the lists' first entries (step 2, once the
+  /// starts are in cache). Inlined by force: GCC drops the calls to a
+  /// function whose only effect is a prefetch.
+  [[gnu::always_inline]] void prefetchListStarts(CandidateIndex t) const {
+    for (EdgeIndex e : scaffold_.candidates[t].edges)
+      if (e < scaffold_.numberOfEdges())
+        __builtin_prefetch(&scaffold_.edge_offsets[e]);
+  }
+  [[gnu::always_inline]] void prefetchLists(CandidateIndex t) const {
+    for (EdgeIndex e : scaffold_.candidates[t].edges)
+      if (e < scaffold_.numberOfEdges())
+        __builtin_prefetch(scaffold_.edgeBegin(e));
+  }
+
   /// Numbers the edges of the members without edges (the type III ones in
   /// Q2) and lists them on those edges. Called once, when Q2 is built.
   void addLateCandidates(const std::vector<CandidateIndex> &members);

@@ -298,8 +298,10 @@ void GreedyMesher::Impl::runPass(State queue_state, PassStatistics &statistics) 
     states_[t].state = State::idle;
     ++statistics.popped;
     decide(t, queue_state, statistics);
-    if (const QueueEntry *next = queue.heapTop())
+    if (const QueueEntry *next = queue.heapTop()) {
       mesh_.prefetchAround(next->candidate());
+      graph_.prefetchListStarts(next->candidate());
+    }
   }
 }
 
@@ -319,6 +321,7 @@ void GreedyMesher::Impl::undoCostlierOnFullEdges(CandidateIndex t, PassStatistic
 }
 
 void GreedyMesher::Impl::decide(CandidateIndex t, State from, PassStatistics &statistics) {
+  graph_.prefetchLists(t); // for the close-ranking rule, after the edge and vertex rules
   // 1. Edge rule: at most two triangles per edge.
   if (hasFullEdge(t)) {
     if (parameters_.error_recovery)
