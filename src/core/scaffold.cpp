@@ -144,9 +144,9 @@ std::optional<Circle> circumcircle(const Eigen::Vector3d &a, const EdgeVectors &
   return circle;
 }
 
-// The cloud's points are in the user's order, not the cells': the candidate
-// loop fetches the corner points of the cell this many steps ahead, whose
-// vertices prefetchNeighbours has fetched by then.
+// The candidate loop reads a facet's corners from the points (by index), not
+// from the vertex records: it fetches the corner points of the cell this many
+// steps ahead, whose vertices prefetchNeighbours has fetched by then.
 constexpr std::size_t corner_prefetch_distance = 4;
 
 // Cells are visited in memory order, but their neighbours, which every
