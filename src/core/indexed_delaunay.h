@@ -17,8 +17,10 @@
 #include <CGAL/property_map.h>
 #include <CGAL/spatial_sort.h>
 #include <Eigen/Core>
+#include <boost/range/irange.hpp>
 
 #include <cstdint>
+#include <iterator>
 #include <utility>
 #include <vector>
 
@@ -37,11 +39,13 @@ using CellHandle = Delaunay::Cell_handle;
 using VertexHandle = Delaunay::Vertex_handle;
 using IndexedPoint = std::pair<KernelPoint, VertexIndex>;
 
-/// (points[i], i) for every i of `chosen`, in that order: insertIndexed's input.
-inline std::vector<IndexedPoint> indexedPoints(const std::vector<Eigen::Vector3d> &points,
-                                               const std::vector<VertexIndex> &chosen) {
+/// (points[i], i) for every i of `chosen` (any range of indices), in that
+/// order: insertIndexed's input.
+template <typename Indices>
+std::vector<IndexedPoint> indexedPoints(const std::vector<Eigen::Vector3d> &points,
+                                        const Indices &chosen) {
   std::vector<IndexedPoint> input;
-  input.reserve(chosen.size());
+  input.reserve(static_cast<std::size_t>(std::distance(std::begin(chosen), std::end(chosen))));
   for (VertexIndex i : chosen)
     input.emplace_back(KernelPoint(points[i].x(), points[i].y(), points[i].z()), i);
   return input;
@@ -49,10 +53,8 @@ inline std::vector<IndexedPoint> indexedPoints(const std::vector<Eigen::Vector3d
 
 /// (points[i], i) for every point.
 inline std::vector<IndexedPoint> indexedPoints(const std::vector<Eigen::Vector3d> &points) {
-  std::vector<VertexIndex> all(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i)
-    all[i] = static_cast<VertexIndex>(i);
-  return indexedPoints(points, all);
+  return indexedPoints(points,
+                       boost::irange<VertexIndex>(0, static_cast<VertexIndex>(points.size())));
 }
 
 /// Inserts the points of `input`, each vertex holding its index, in the

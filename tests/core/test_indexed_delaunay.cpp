@@ -92,5 +92,5 @@ TEST(IndexedDelaunay, ChosenPointsKeepTheirOwnIndices) {
     const Eigen::Vector3d &p = points[chosen[k]];
     EXPECT_EQ(input[k].first, KernelPoint(p.x(), p.y(), p.z()));
   }
-  EXPECT_TRUE(detail::indexedPoints(points, {}).empty());
+  EXPECT_TRUE(detail::indexedPoints(points, std::vector<VertexIndex>{}).empty());
 }
