@@ -345,8 +345,10 @@ public:
       std::vector<bool> may_pinch(points_.size(), false);
       for (std::size_t v = 0; v < points_.size(); ++v)
         may_pinch[v] = may_pinch_[v] != 0;
-      surface_.statistics.bow_tie_triangles_removed =
-          splitBowTies(surface_.triangles, points_.size(), may_pinch);
+      detail::withThreads(parameters_.num_threads, [&] {
+        surface_.statistics.bow_tie_triangles_removed =
+            splitBowTies(surface_.triangles, points_.size(), may_pinch);
+      });
     }
     surface_.statistics.seams_seconds = secondsSince(stage);
     return std::move(surface_);

@@ -55,7 +55,7 @@ std::vector<std::uint64_t> bowTieTriangles(std::vector<AtVertex> &at) {
       around.push_back(static_cast<std::uint32_t>(corners.size()));
       corners.push_back(at[k].corners);
     }
-    dropBowTieFans(at[i].vertex, around, corners, {}, drop);
+    dropBowTieFans(at[i].vertex, around.data(), around.data() + around.size(), corners, {}, drop);
     for (std::uint32_t local : drop)
       going.push_back(at[i + local].triangle);
     i = j;

@@ -207,11 +207,11 @@ std::vector<std::uint32_t> orientAlongNeighbours(std::vector<Triangle> &triangle
 void dropTriangles(std::vector<Triangle> &triangles, const std::vector<bool> &drop,
                    std::vector<bool> &touched, MeshEdges *edges = nullptr);
 
-/// One vertex's share of a round of splitBowTies(): the triangles `around`
-/// v (ascending; numbers into `triangles`) grouped into fans joined by
-/// edges at v, and those of every fan but the one to keep (fan_choice.h)
-/// appended to `drop`, except those is_fixed (if given) marks.
-void dropBowTieFans(VertexIndex v, const std::vector<std::uint32_t> &around,
+/// One vertex's share of a round of splitBowTies(): the triangles [first,
+/// last) around v (ascending; numbers into `triangles`) grouped into fans
+/// joined by edges at v, and those of every fan but the one to keep
+/// (fan_choice.h) appended to `drop`, except those is_fixed (if given) marks.
+void dropBowTieFans(VertexIndex v, const std::uint32_t *first, const std::uint32_t *last,
                     const std::vector<Triangle> &triangles,
                     const std::function<bool(std::uint32_t)> &is_fixed,
                     std::vector<std::uint32_t> &drop);

@@ -551,6 +551,34 @@ TEST(BowTies, SplitNeverRemovesFixedTriangles) {
                            {0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 5, 6}, {7, 8, 9}, {7, 9, 10}}));
 }
 
+TEST(BowTies, ManyPinchesSplitTheSameOnOneAndTwoThreads) {
+  // 12,000 bow-ties, more than one block of vertices per thread: at each
+  // centre a fan of two triangles stays and a lone triangle goes. Centres
+  // are 6 apart, so the marked vertices fall in every 64-vertex word of the
+  // rank lookup, some words dense (every vertex of the first 600 marked).
+  constexpr VertexIndex pinches = 12000, stride = 6;
+  std::vector<Triangle> bow_ties, expected;
+  std::vector<bool> touched(pinches * stride, false);
+  for (VertexIndex k = 0; k < pinches; ++k) {
+    const VertexIndex c = k * stride;
+    bow_ties.push_back({c, c + 1, c + 2});
+    bow_ties.push_back({c, c + 2, c + 3});
+    bow_ties.push_back({c, c + 4, c + 5});
+    expected.push_back({c, c + 1, c + 2});
+    expected.push_back({c, c + 2, c + 3});
+    touched[c] = true;
+  }
+  std::fill(touched.begin(), touched.begin() + 600, true);
+  for (int threads : {1, 2}) {
+    std::vector<Triangle> triangles = bow_ties;
+    std::vector<bool> marked = touched;
+    const std::size_t removed = detail::withThreads(
+        threads, [&] { return splitBowTies(triangles, touched.size(), marked); });
+    EXPECT_EQ(removed, std::size_t{pinches}) << threads << " threads";
+    EXPECT_EQ(triangles, expected) << threads << " threads";
+  }
+}
+
 // ---- finish --------------------------------------------------------------------------
 
 TEST(Finish, BoundaryLoopOfTwoTriangles) {
