@@ -54,6 +54,7 @@ public:
     } else {
       root_ = buildMedian(order, 0, order.size(), Box(), bucket_points, 0);
     }
+    fillLeaves(order);
     numberLeaves(root_);
   }
 
@@ -89,15 +90,29 @@ public:
   }
 
 private:
-  int makeLeaf(std::vector<VertexIndex> &order, std::size_t begin, std::size_t end,
-               const Box &region, int depth) {
+  /// A leaf over order[begin, end); fillLeaves gives it its points.
+  int makeLeaf(std::size_t begin, std::size_t end, const Box &region, int depth) {
     Node node;
     node.region = region;
     node.depth = depth;
-    node.points.assign(order.begin() + begin, order.begin() + end);
-    std::sort(node.points.begin(), node.points.end());
     nodes_.push_back(std::move(node));
+    leaf_ranges_.push_back({static_cast<int>(nodes_.size() - 1), begin, end});
     return static_cast<int>(nodes_.size() - 1);
+  }
+
+  /// Each leaf's points, ascending: one pass over the points in index order
+  /// instead of a sort per leaf.
+  void fillLeaves(const std::vector<VertexIndex> &order) {
+    std::vector<int> leaf_node(points_.size(), -1);
+    for (const LeafRange &range : leaf_ranges_) {
+      nodes_[static_cast<std::size_t>(range.node)].points.reserve(range.end - range.begin);
+      for (std::size_t i = range.begin; i < range.end; ++i)
+        leaf_node[order[i]] = range.node;
+    }
+    for (VertexIndex v = 0; v < points_.size(); ++v)
+      if (leaf_node[v] >= 0)
+        nodes_[static_cast<std::size_t>(leaf_node[v])].points.push_back(v);
+    leaf_ranges_ = {};
   }
 
   int makeInner(const Box &region, int axis, double split, int depth, int left, int right) {
@@ -110,7 +125,7 @@ private:
     if (begin == end)
       return -1;
     if (end - begin <= bucket_points)
-      return makeLeaf(order, begin, end, region, depth);
+      return makeLeaf(begin, end, region, depth);
     Eigen::Vector3d low = points_[order[begin]], high = low;
     for (std::size_t i = begin; i < end; ++i) {
       low = low.cwiseMin(points_[order[i]]);
@@ -141,7 +156,7 @@ private:
       return -1;
     const detail::GridHalves halves = detail::halveGrid(region, first, last, grid_low_, grid_cell_);
     if (halves.leaf)
-      return makeLeaf(order, begin, end, region, depth);
+      return makeLeaf(begin, end, region, depth);
     // Sides by the plane itself, so every point lies in its leaf's region:
     // a cell number computed as floor((p - low) / cell) can round across
     // the plane when coordinates span many orders of magnitude.
@@ -164,8 +179,15 @@ private:
         leaf_of_[v] = nodes_[static_cast<std::size_t>(leaf)].first_leaf;
   }
 
+  /// A leaf and its part of the order, until fillLeaves.
+  struct LeafRange {
+    int node;
+    std::size_t begin, end;
+  };
+
   const std::vector<Eigen::Vector3d> &points_;
   std::vector<Node> nodes_;
+  std::vector<LeafRange> leaf_ranges_;
   std::vector<int> leaves_;
   std::vector<std::uint32_t> leaf_of_;
   int root_ = -1;
@@ -186,9 +208,11 @@ double medianSpacing(const std::vector<Eigen::Vector3d> &points,
 /// grid), all take the whole cloud's, so that their margins reach their
 /// neighbours and the seams can join them.
 std::vector<double> bucketSpacings(const std::vector<Eigen::Vector3d> &points, BucketTree &tree) {
-  std::vector<double> spacings;
-  for (int leaf : tree.leaves())
-    spacings.push_back(medianSpacing(points, tree.nodes()[leaf].points));
+  const std::vector<int> &leaves = tree.leaves();
+  std::vector<double> spacings(leaves.size());
+  detail::parallelFor(std::size_t(0), leaves.size(), [&](std::size_t i) {
+    spacings[i] = medianSpacing(points, tree.nodes()[static_cast<std::size_t>(leaves[i])].points);
+  });
   double fallback = *std::max_element(spacings.begin(), spacings.end());
   if (!(fallback > 0)) {
     std::vector<VertexIndex> all(points.size());
@@ -238,7 +262,8 @@ public:
 
     // Each bucket's margin follows its own spacing: a triangle is up to rho
     // local scales long, and a sparse bucket's scale is larger.
-    const std::vector<double> spacings = bucketSpacings(points_, tree_);
+    const std::vector<double> spacings = detail::withThreads(
+        parameters_.num_threads, [&] { return bucketSpacings(points_, tree_); });
     leaf_margin_.resize(spacings.size());
     for (std::size_t leaf = 0; leaf < spacings.size(); ++leaf)
       leaf_margin_[leaf] = detail::bucketMargin(parameters_.rho, spacings[leaf]);
