@@ -70,19 +70,32 @@ FarPoints findFarPoints(const std::vector<Eigen::Vector3f> &points) {
     return far;
   const std::size_t n = points.size();
   const std::size_t tail = tailRank(n);
-  Eigen::Vector3d central_low, central_high;
-  // The axes are independent selections: one thread each.
+  Eigen::Vector3d central_low, central_high, median_of_all;
+  // Each axis's median first (one thread per axis): it splits the values
+  // into halves that hold the ranks below and above it, where the central
+  // box's sides are then selected, six selections on half the values each.
+  const std::size_t middle = n / 2, high_rank = n - 1 - tail;
+  std::vector<float> values[3];
+  auto select = [&](std::size_t axis, std::size_t begin, std::size_t rank, std::size_t end) {
+    const auto first = values[axis].begin();
+    std::nth_element(first + static_cast<std::ptrdiff_t>(begin),
+                     first + static_cast<std::ptrdiff_t>(rank),
+                     first + static_cast<std::ptrdiff_t>(end));
+    return selectedValue(values[axis][rank]);
+  };
   parallelFor(0, 3, [&](std::size_t axis) {
-    std::vector<float> values(n);
+    values[axis].resize(n);
     for (std::size_t i = 0; i < n; ++i)
-      values[i] = points[i][axis];
-    auto at = [&](std::size_t k) {
-      std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k),
-                       values.end());
-      return selectedValue(values[k]);
-    };
-    central_low[axis] = at(tail);
-    central_high[axis] = at(n - 1 - tail);
+      values[axis][i] = points[i][axis];
+    median_of_all[axis] = select(axis, 0, middle, n);
+  });
+  parallelFor(0, 6, [&](std::size_t side) {
+    const std::size_t axis = side / 2;
+    if (side % 2 == 0)
+      central_low[axis] = tail < middle ? select(axis, 0, tail, middle) : median_of_all[axis];
+    else
+      central_high[axis] =
+          high_rank > middle ? select(axis, middle + 1, high_rank, n) : median_of_all[axis];
   });
   const double size = (central_high - central_low).norm();
 
@@ -104,16 +117,17 @@ FarPoints findFarPoints(const std::vector<Eigen::Vector3f> &points) {
     }
 
   // The median of the points kept, so that far points change nothing.
-  parallelFor(0, 3, [&](std::size_t axis) {
-    std::vector<float> values;
-    values.reserve(n - far.count);
-    for (std::size_t i = 0; i < n; ++i)
-      if (!far.is_far[i])
-        values.push_back(points[i][axis]);
-    auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-    std::nth_element(values.begin(), middle, values.end());
-    far.median[axis] = selectedValue(*middle);
-  });
+  if (far.count == 0) {
+    far.median = median_of_all;
+  } else {
+    parallelFor(0, 3, [&](std::size_t axis) {
+      values[axis].clear();
+      for (std::size_t i = 0; i < n; ++i)
+        if (!far.is_far[i])
+          values[axis].push_back(points[i][axis]);
+      far.median[axis] = select(axis, 0, values[axis].size() / 2, values[axis].size());
+    });
+  }
   far.low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   far.high = -far.low;
   for (std::size_t i = 0; i < n; ++i)

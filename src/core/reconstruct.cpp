@@ -169,8 +169,13 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
   std::vector<detail::PointKey> keys(records.size());
   {
     const detail::MortonCells cells(far.low, far.high);
-    for (std::size_t i = 0; i < records.size(); ++i)
-      keys[i] = cells.key(detail::recordAt(view.xyz, view.stride, records[i]), records[i]);
+    constexpr std::size_t grain = 1 << 14;
+    detail::parallelFor(tbb::blocked_range<std::size_t>(0, records.size(), grain),
+                        [&](const tbb::blocked_range<std::size_t> &part) {
+                          for (std::size_t i = part.begin(); i != part.end(); ++i)
+                            keys[i] = cells.key(detail::recordAt(view.xyz, view.stride, records[i]),
+                                                records[i]);
+                        });
   }
   records.clear();
   records.shrink_to_fit();

@@ -2,9 +2,12 @@
 // Far stray points: a few points at wildly different magnitudes must neither
 // slow the method down nor change the mesh of the rest of the cloud.
 #include "core_test_support.h"
+#include "far_points.h"
+#include "threads.h"
 
 #include <algorithm>
 #include <chrono>
+#include <random>
 
 namespace {
 
@@ -70,6 +73,66 @@ TEST(FarPoints, OnlyTheLonePointIsLeftOut) {
   EXPECT_EQ(result.far_points, 1u);
   EXPECT_EQ(result.used_points, 500u);
   EXPECT_TRUE(result.boundary_loops.empty());
+}
+
+TEST(FarPoints, SelectionsMatchSortedValuesAtEverySize) {
+  // The central box's sides and the centre are values of given ranks on
+  // each axis; findFarPoints selects them in parts. Checked against sorted
+  // copies, on one and two threads, at sizes around the ranks' edge cases
+  // (one value, a tail rank of 0 or 1), with repeated values and stray points.
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
+  for (std::size_t n : {1u, 2u, 3u, 4u, 99u, 100u, 101u, 257u, 1000u, 4097u}) {
+    std::vector<Eigen::Vector3f> points(n);
+    for (Eigen::Vector3f &p : points)
+      p = Eigen::Vector3f(uniform(random), std::round(uniform(random) * 4), uniform(random));
+    if (n > 50) // a pair of strays at one place, and a lone one
+      points[n / 3] = points[n / 5] = Eigen::Vector3f(1e6f, 0, 0);
+    if (n > 60)
+      points[n / 7] = Eigen::Vector3f(0, -3e5f, 2e5f);
+    // The reference: sorted copies.
+    const std::size_t tail = pcl_ms::detail::tailRank(n);
+    Eigen::Vector3d low, high;
+    for (int axis = 0; axis < 3; ++axis) {
+      std::vector<float> sorted;
+      for (const Eigen::Vector3f &p : points)
+        sorted.push_back(p[axis]);
+      std::sort(sorted.begin(), sorted.end());
+      low[axis] = sorted[tail];
+      high[axis] = sorted[n - 1 - tail];
+    }
+    const double size = (high - low).norm();
+    std::vector<Eigen::Vector3f> outside;
+    std::vector<std::size_t> outside_index;
+    for (std::size_t i = 0; i < n; ++i)
+      if (pcl_ms::detail::outsideCentralBox(points[i], low, high, size)) {
+        outside.push_back(points[i]);
+        outside_index.push_back(i);
+      }
+    std::vector<bool> is_far(n, false);
+    const std::vector<bool> isolated = pcl_ms::detail::isolatedOutside(outside, low, high, size);
+    for (std::size_t k = 0; k < outside.size(); ++k)
+      is_far[outside_index[k]] = isolated[k];
+    Eigen::Vector3d median;
+    for (int axis = 0; axis < 3; ++axis) {
+      std::vector<float> kept;
+      for (std::size_t i = 0; i < n; ++i)
+        if (!is_far[i])
+          kept.push_back(points[i][axis]);
+      std::sort(kept.begin(), kept.end());
+      median[axis] = kept[kept.size() / 2];
+    }
+    for (int threads : {1, 2}) {
+      const pcl_ms::detail::FarPoints far = pcl_ms::detail::withThreads(
+          threads, [&] { return pcl_ms::detail::findFarPoints(points); });
+      EXPECT_EQ(far.is_far, is_far) << n << " points, " << threads << " threads";
+      EXPECT_EQ(far.median, median) << n << " points, " << threads << " threads";
+    }
+    if (n >= 1000) { // with enough points the lone stray is far, the pair is not
+      EXPECT_TRUE(is_far[n / 7]) << n;
+      EXPECT_FALSE(is_far[n / 3]) << n;
+    }
+  }
 }
 
 } // namespace
