@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -61,7 +62,18 @@ struct Box {
     box.high.array() += width;
     return box;
   }
+  void extend(const Eigen::Vector3d &p) {
+    low = low.cwiseMin(p);
+    high = high.cwiseMax(p);
+  }
 };
+
+/// A box that holds nothing until extended.
+inline Box emptyBox() {
+  Box box;
+  std::swap(box.low, box.high);
+  return box;
+}
 
 /// The slab of a seam zone: `region` (the zone's node) grown by the larger
 /// of its buckets' widest margin and `half_width`, cut to `half_width` on
@@ -72,6 +84,82 @@ inline Box zoneSlab(const Box &region, int axis, double split, double margin, do
   slab.high[axis] = std::min(slab.high[axis], split + half_width);
   return slab;
 }
+
+/// How far a seam zone reaches from its plane, tile by tile (docs/algorithm.md
+/// section 5, "How wide a zone is"). A triangle across the plane has sides
+/// shorter than rho times the largest scale of its corners, so each corner
+/// lies within that distance of the plane and of the corner with that scale.
+/// The plane is cut into square tiles at least as wide as the widest such
+/// reach: that corner then lies in the tile of any other corner or in one of
+/// the 8 around it (a point beyond the tiles counts in the nearest, as the
+/// corner near the plane is within a tile of it). A point of the widest slab
+/// belongs to the zone when it lies within rho times the largest scale near
+/// the plane in its 3 x 3 tiles.
+class ZoneReach {
+public:
+  /// `near_plane`: the bounds of the points within the margin of the plane,
+  /// whose scales are added; `largest_scale`: the largest of them.
+  ZoneReach(const Box &near_plane, int axis, double split, double rho, float largest_scale)
+      : axis_(axis), split_(split), rho_(rho) {
+    const double widest = rho * largest_scale;
+    for (int k = 0; k < 2; ++k) {
+      const int a = (axis + 1 + k) % 3;
+      along_[k] = a;
+      low_[k] = near_plane.low[a];
+      const double extent = near_plane.high[a] - near_plane.low[a];
+      tile_[k] = std::max(widest, extent / max_tiles_per_side);
+      if (!std::isfinite(extent) || !(extent > 0) || !std::isfinite(tile_[k])) {
+        tile_[k] = 1;
+        count_[k] = 1;
+        continue;
+      }
+      count_[k] = std::min(max_tiles_per_side, static_cast<std::size_t>(extent / tile_[k]) + 1);
+    }
+    scales_.assign(count_[0] * count_[1], 0.0f);
+  }
+
+  /// A point within the margin of the plane, with its scale.
+  void addScale(const Eigen::Vector3d &point, float scale) {
+    float &tile = scales_[tileOf(point)];
+    tile = std::max(tile, scale);
+  }
+
+  /// Whether a point of the widest slab lies within its tiles' reach.
+  bool reaches(const Eigen::Vector3d &point) const {
+    const std::size_t i = cellOf(point, 0), j = cellOf(point, 1);
+    float largest = 0;
+    for (std::size_t ii = i > 0 ? i - 1 : 0; ii <= std::min(i + 1, count_[0] - 1); ++ii)
+      for (std::size_t jj = j > 0 ? j - 1 : 0; jj <= std::min(j + 1, count_[1] - 1); ++jj)
+        largest = std::max(largest, scales_[ii * count_[1] + jj]);
+    const double half_width = rho_ * largest;
+    return point[axis_] >= split_ - half_width && point[axis_] <= split_ + half_width;
+  }
+
+  /// The tiles' largest scales, to be joined with other processes'.
+  std::vector<float> &tileScales() { return scales_; }
+
+private:
+  // Enough to follow the scales along a plane; bounds the processes' exchange.
+  static constexpr std::size_t max_tiles_per_side = 256;
+
+  std::size_t cellOf(const Eigen::Vector3d &point, int k) const {
+    const double offset = (point[along_[k]] - low_[k]) / tile_[k];
+    if (!(offset >= 1)) // NaN too
+      return 0;
+    const std::size_t last = count_[k] - 1;
+    return offset >= static_cast<double>(last) ? last : static_cast<std::size_t>(offset);
+  }
+  std::size_t tileOf(const Eigen::Vector3d &point) const {
+    return cellOf(point, 0) * count_[1] + cellOf(point, 1);
+  }
+
+  int axis_;
+  double split_, rho_;
+  std::array<int, 2> along_{};
+  std::array<double, 2> low_{}, tile_{};
+  std::array<std::size_t, 2> count_{};
+  std::vector<float> scales_;
+};
 
 /// A node of the bucket tree. Leaves are buckets; an inner node's split
 /// plane is the seam between its two subtrees. Leaves are numbered in

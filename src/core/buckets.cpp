@@ -611,17 +611,28 @@ private:
   }
 
   /// The zone along node's split plane: the points within rho times the
-  /// largest scale among `near_plane` (nearPlane). A triangle across the
-  /// plane is shorter than that, so it is the zone's half width; a sparse
-  /// part's can exceed the buckets' margin. Those of the subtree are its
-  /// core; the others, of neighbouring subtrees, lie within the margin
+  /// largest scale among the points of `near_plane` (nearPlane) around them
+  /// (ZoneReach). A triangle across the plane is shorter than that; a sparse
+  /// part's reach can exceed the buckets' margin. Those of the subtree are
+  /// its core; the others, of neighbouring subtrees, lie within the margin
   /// around the node's region.
   std::vector<VertexIndex> zonePoints(const Node &node,
                                       const std::vector<VertexIndex> &near_plane) const {
     float largest_scale = 0;
-    for (VertexIndex v : near_plane)
+    Box bounds = detail::emptyBox();
+    for (VertexIndex v : near_plane) {
       largest_scale = std::max(largest_scale, surface_.local_scale[v]);
-    return tree_.gather(zoneSlab(node, parameters_.rho * largest_scale));
+      bounds.extend(points_[v]);
+    }
+    const Box slab = zoneSlab(node, parameters_.rho * largest_scale);
+    detail::ZoneReach reach(bounds, node.axis, node.split, parameters_.rho, largest_scale);
+    for (VertexIndex v : near_plane)
+      reach.addScale(points_[v], surface_.local_scale[v]);
+    std::vector<VertexIndex> zone = tree_.gather(slab);
+    zone.erase(std::remove_if(zone.begin(), zone.end(),
+                              [&](VertexIndex v) { return !reach.reaches(points_[v]); }),
+               zone.end());
+    return zone;
   }
 
   std::vector<VertexIndex> zonePoints(const Node &node) const {

@@ -445,27 +445,69 @@ private:
       return ownerOf(tree_.nodes[static_cast<std::size_t>(node)].first_leaf);
     };
 
-    // The largest local scale near each plane, from every home.
-    std::vector<double> margin(level.size()), largest(level.size(), 0.0);
+    // The largest local scale near each plane and those points' bounds,
+    // from every home: per zone the scale, then -low and high.
+    constexpr std::size_t per_zone = 7;
+    std::vector<double> margin(level.size()), near_figures(per_zone * level.size());
+    std::vector<Box> near_planes;
     for (std::size_t z = 0; z < level.size(); ++z) {
       const Node &node = tree_.nodes[static_cast<std::size_t>(level[z])];
       margin[z] = subtree_margin_[static_cast<std::size_t>(level[z])];
-      const Box slab = detail::zoneSlab(node.region, node.axis, node.split, margin[z], margin[z]);
+      near_planes.push_back(
+          detail::zoneSlab(node.region, node.axis, node.split, margin[z], margin[z]));
       float scale = 0;
-      forEachHomeIn(slab, [&](std::size_t i) { scale = std::max(scale, home_scale_[i]); });
-      largest[z] = scale;
+      Box bounds = detail::emptyBox();
+      forEachHomeIn(near_planes.back(), [&](std::size_t i) {
+        scale = std::max(scale, home_scale_[i]);
+        bounds.extend(home_.positions[i]);
+      });
+      double *figures = &near_figures[per_zone * z];
+      figures[0] = scale;
+      for (int a = 0; a < 3; ++a) {
+        figures[1 + a] = -bounds.low[a];
+        figures[4 + a] = bounds.high[a];
+      }
     }
-    group_.maximum(largest);
+    group_.maximum(near_figures);
+
+    // How far each zone reaches, tile by tile along its plane, from every
+    // home's scales near the plane (as in one process: ZoneReach).
+    std::vector<detail::ZoneReach> reaches;
+    std::vector<Box> slabs;
+    std::vector<double> tile_scales;
+    for (std::size_t z = 0; z < level.size(); ++z) {
+      const Node &node = tree_.nodes[static_cast<std::size_t>(level[z])];
+      const double *figures = &near_figures[per_zone * z];
+      const auto largest_scale = static_cast<float>(figures[0]);
+      Box bounds;
+      for (int a = 0; a < 3; ++a) {
+        bounds.low[a] = -figures[1 + a];
+        bounds.high[a] = figures[4 + a];
+      }
+      slabs.push_back(detail::zoneSlab(node.region, node.axis, node.split, margin[z],
+                                       parameters_.rho * largest_scale));
+      reaches.emplace_back(bounds, node.axis, node.split, parameters_.rho, largest_scale);
+      forEachHomeIn(near_planes[z], [&](std::size_t i) {
+        reaches.back().addScale(home_.positions[i], home_scale_[i]);
+      });
+      const std::vector<float> &scales = reaches.back().tileScales();
+      tile_scales.insert(tile_scales.end(), scales.begin(), scales.end());
+    }
+    group_.maximum(tile_scales);
+    {
+      std::size_t next = 0;
+      for (detail::ZoneReach &reach : reaches)
+        for (float &scale : reach.tileScales())
+          scale = static_cast<float>(tile_scales[next++]);
+    }
 
     // Each zone's points, from their homes, to its owner.
     std::vector<std::vector<PointFor>> outgoing(processes);
     for (std::size_t z = 0; z < level.size(); ++z) {
-      const Node &node = tree_.nodes[static_cast<std::size_t>(level[z])];
-      const double half_width = parameters_.rho * static_cast<float>(largest[z]);
-      const Box slab = detail::zoneSlab(node.region, node.axis, node.split, margin[z], half_width);
-      forEachHomeIn(slab, [&](std::size_t i) {
-        outgoing[static_cast<std::size_t>(zoneOwner(level[z]))].push_back(
-            {homeRecord(i), static_cast<std::uint32_t>(z)});
+      forEachHomeIn(slabs[z], [&](std::size_t i) {
+        if (reaches[z].reaches(home_.positions[i]))
+          outgoing[static_cast<std::size_t>(zoneOwner(level[z]))].push_back(
+              {homeRecord(i), static_cast<std::uint32_t>(z)});
       });
     }
     std::vector<std::vector<PointRecord>> zone_points(level.size());
