@@ -405,6 +405,16 @@ private:
       }
     if (circumradii.empty())
       throw ReconstructionError("all points are collinear: no surface can be built");
+    if (options_.local_scale && options_.local_scale->size() == n &&
+        std::all_of(options_.local_scale->begin(), options_.local_scale->end(),
+                    [](float scale) { return scale > 0; })) {
+      // Every scale given (a seam zone's points, all from meshed buckets):
+      // nothing below would be used but d_med.
+      scaffold_.d_med = options_.d_med > 0 ? options_.d_med : median(circumradii);
+      scaffold_.d_max = options_.rho * scaffold_.d_med;
+      scaffold_.local_scale = *options_.local_scale;
+      return;
+    }
     std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
     std::vector<float> radii_at(offsets[n]);
     std::vector<VertexIndex> corners_at(2 * std::size_t{offsets[n]});
