@@ -341,6 +341,41 @@ TEST(Scaffold, FacetsTooThinForDoublesAreLeftOutNotNaN) {
   }
 }
 
+TEST(Scaffold, ScalesGivenForEveryPointAreUsedAsTheyAre) {
+  // A seam zone's points all come with their buckets' scales, and the
+  // scaffold then skips measuring them: it must build what it builds when
+  // it measures (here forced by one point without a scale).
+  const std::vector<Eigen::Vector3d> points = pcl_ms_test::bunnyReference().vertices;
+  const MedialScaffold measured = buildMedialScaffold(points, {});
+  std::vector<float> given = measured.local_scale;
+  for (std::size_t v = 0; v < given.size(); ++v)
+    given[v] *= v % 3 == 0 ? 1.5f : 0.8f; // not what the cloud would measure
+  ScaffoldOptions options;
+  options.local_scale = &given;
+  const MedialScaffold all_given = buildMedialScaffold(points, options);
+  EXPECT_EQ(all_given.local_scale, given);
+  EXPECT_EQ(all_given.d_med, measured.d_med);
+  EXPECT_EQ(all_given.d_max, options.rho * measured.d_med);
+
+  const VertexIndex unscaled = 1000;
+  std::vector<float> one_missing = given;
+  one_missing[unscaled] = 0;
+  options.local_scale = &one_missing;
+  const MedialScaffold measuring = buildMedialScaffold(points, options);
+  EXPECT_EQ(measuring.d_med, measured.d_med);
+  auto awayFromUnscaled = [&](const MedialScaffold &scaffold) {
+    std::vector<std::pair<Triangle, float>> kept;
+    for (const Candidate &candidate : scaffold.candidates)
+      if (std::find(candidate.vertices.begin(), candidate.vertices.end(), unscaled) ==
+          candidate.vertices.end())
+        kept.emplace_back(candidate.vertices, candidate.base_cost);
+    return kept;
+  };
+  const auto expected = awayFromUnscaled(measuring);
+  EXPECT_GT(expected.size(), 100000u);
+  EXPECT_EQ(awayFromUnscaled(all_given), expected);
+}
+
 TEST(Scaffold, CollinearPointsAreRejected) {
   const std::vector<Eigen::Vector3d> line = {{0, 0, 0}, {1, 1, 1}, {2, 2, 2}, {3, 3, 3}};
   EXPECT_THROW(buildMedialScaffold(line, {}), ReconstructionError);
