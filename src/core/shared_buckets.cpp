@@ -446,9 +446,9 @@ private:
     };
 
     // The largest local scale near each plane and those points' bounds,
-    // from every home: per zone the scale, then -low and high.
-    constexpr std::size_t per_zone = 7;
-    std::vector<double> margin(level.size()), near_figures(per_zone * level.size());
+    // from every home.
+    std::vector<double> margin(level.size()), largest(level.size(), 0.0);
+    std::vector<double> low(3 * level.size()), high(3 * level.size());
     std::vector<Box> near_planes;
     for (std::size_t z = 0; z < level.size(); ++z) {
       const Node &node = tree_.nodes[static_cast<std::size_t>(level[z])];
@@ -461,14 +461,15 @@ private:
         scale = std::max(scale, home_scale_[i]);
         bounds.extend(home_.positions[i]);
       });
-      double *figures = &near_figures[per_zone * z];
-      figures[0] = scale;
+      largest[z] = scale;
       for (int a = 0; a < 3; ++a) {
-        figures[1 + a] = -bounds.low[a];
-        figures[4 + a] = bounds.high[a];
+        low[3 * z + a] = bounds.low[a];
+        high[3 * z + a] = bounds.high[a];
       }
     }
-    group_.maximum(near_figures);
+    group_.maximum(largest);
+    group_.minimum(low);
+    group_.maximum(high);
 
     // How far each zone reaches, tile by tile along its plane, from every
     // home's scales near the plane (as in one process: ZoneReach).
@@ -477,12 +478,11 @@ private:
     std::vector<double> tile_scales;
     for (std::size_t z = 0; z < level.size(); ++z) {
       const Node &node = tree_.nodes[static_cast<std::size_t>(level[z])];
-      const double *figures = &near_figures[per_zone * z];
-      const auto largest_scale = static_cast<float>(figures[0]);
+      const auto largest_scale = static_cast<float>(largest[z]);
       Box bounds;
       for (int a = 0; a < 3; ++a) {
-        bounds.low[a] = -figures[1 + a];
-        bounds.high[a] = figures[4 + a];
+        bounds.low[a] = low[3 * z + a];
+        bounds.high[a] = high[3 * z + a];
       }
       slabs.push_back(detail::zoneSlab(node.region, node.axis, node.split, margin[z],
                                        parameters_.rho * largest_scale));
