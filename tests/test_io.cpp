@@ -293,6 +293,36 @@ TEST_F(IoLoadPointCloud, RangeGridScanGivesVerticesInFileOrder) {
   EXPECT_FLOAT_EQ(points[2].x, 3.0f);
 }
 
+TEST_F(IoLoadPointCloud, ObjInfoGridThatCannotHoldTheVerticesFails) {
+  // PCL's reader sizes the vertex data for the grid that obj_info num_cols
+  // and num_rows give (atoi of the third word) and aborts on a vertex past
+  // it; a grid far larger than the vertices only allocates. Found by fuzzing.
+  const std::string body = "1 0 0\n2 0 0\n3 0 0\n4 0 0\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {"element vertex 4\nobj_info num_cols ny\n", "0 x 1 grid"},
+      {"element vertex 4\nobj_info num_cols \n", "0 x 1 grid"}, // "" after the blank
+      {"obj_info num_cols 3\nobj_info num_rows 1\nelement vertex 4\n", "3 x 1 grid"},
+      {"element vertex 4\nobj_info num_rows 2\n", "4 x 2 grid"},
+      {"obj_info num_cols -1\nobj_info num_rows 1\nelement vertex 4\n", "4294967295 x 1"}};
+  for (const auto &[lines, message] : cases) {
+    SCOPED_TRACE(lines);
+    writeFile(path("grid.ply"), "ply\nformat ascii 1.0\n" + lines +
+                                    "property float x\nproperty float y\nproperty float z\n"
+                                    "end_header\n" +
+                                    body);
+    EXPECT_TRUE(contains(expectCloudFailure(path("grid.ply")), message));
+  }
+  // A grid as large as the vertices is an organized cloud, and loads.
+  writeFile(path("grid.ply"), "ply\nformat ascii 1.0\nobj_info num_cols 2\n"
+                              "obj_info num_rows 2\nelement vertex 4\nproperty float x\n"
+                              "property float y\nproperty float z\nend_header\n" +
+                                  body);
+  pcl::PCLPointCloud2 loaded;
+  std::string error;
+  ASSERT_TRUE(pcl_ms::loadPointCloud(path("grid.ply"), loaded, error)) << error;
+  EXPECT_EQ(loaded.width * loaded.height, 4u);
+}
+
 TEST_F(IoLoadPointCloud, TruncatedBinaryPcdFails) {
   ASSERT_EQ(pcl::io::savePCDFileBinary(path("full.pcd"), makeCloud(1000)), 0);
   const std::size_t header = headerEnd(path("full.pcd"), "DATA");

@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -64,6 +65,35 @@ std::vector<std::string_view> splitAt(std::string_view text, Separates separates
 /// Words as PCL's PCD reader splits a header line (isPcdBlank).
 std::vector<std::string_view> splitPcdWords(std::string_view text) {
   return splitAt(text, isPcdBlank);
+}
+
+/// Applies an obj_info line as PCL's PLY reader does: split at runs of
+/// spaces and tabs (boost::split, compressed, so a line ending in one has an
+/// empty last word), num_cols and num_rows set the cloud's width and height
+/// through atoi, from the third word of three or more.
+void applyObjInfo(std::string_view line, PlyHeader &header) {
+  std::vector<std::string_view> words;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t end = line.find_first_of(" \t", start);
+    words.push_back(line.substr(start, end == std::string_view::npos ? end : end - start));
+    if (end == std::string_view::npos)
+      break;
+    start = line.find_first_not_of(" \t", end);
+    if (start == std::string_view::npos) {
+      words.emplace_back();
+      break;
+    }
+  }
+  if (words.size() < 3)
+    return;
+  // atoi is (int) strtol in glibc; PCL stores the int in a uint32 field.
+  const auto value = static_cast<std::uint32_t>(
+      static_cast<int>(std::strtol(std::string(words[2]).c_str(), nullptr, 10)));
+  if (words[1] == "num_cols")
+    header.grid_width = value;
+  else if (words[1] == "num_rows")
+    header.grid_height = value;
 }
 
 } // namespace
@@ -255,8 +285,11 @@ bool parsePlyHeader(std::istream &in, PlyHeader &header, std::string &error) {
       // start with the keyword itself.
       error = where + "obj_info must start the line";
       return false;
-    } else if (key == "comment" || key == "obj_info") {
-      header.has_obj_info |= key == "obj_info";
+    } else if (key == "comment") {
+      continue;
+    } else if (key == "obj_info") {
+      header.has_obj_info = true;
+      applyObjInfo(line, header);
       continue;
     } else if (key == "format") {
       // PCL's parser takes one format line, of three words, version 1.0.
@@ -294,6 +327,11 @@ bool parsePlyHeader(std::istream &in, PlyHeader &header, std::string &error) {
       if (header.find(element.name)) {
         error = where + "element " + printable(words[1]) + " is declared twice";
         return false;
+      }
+      // PCL keeps a grid that obj_info lines set in full before the vertices.
+      if (element.name == "vertex" && (header.grid_width == 0 || header.grid_height == 0)) {
+        header.grid_width = static_cast<std::uint32_t>(element.count);
+        header.grid_height = 1;
       }
       header.elements.push_back(std::move(element));
     } else if (key == "property") {
@@ -341,6 +379,19 @@ bool parsePlyHeader(std::istream &in, PlyHeader &header, std::string &error) {
               std::to_string(element.count) + " records but no properties";
       return false;
     }
+  // PCL sizes the vertex data for its grid and aborts on a vertex beyond it;
+  // a grid larger than both the vertices and the range grid only allocates.
+  if (const PlyElement *vertex = header.find("vertex")) {
+    const std::uint64_t grid = std::uint64_t{header.grid_width} * header.grid_height;
+    const PlyElement *range_grid = header.find("range_grid");
+    if (grid < vertex->count ||
+        grid > std::max(vertex->count, range_grid ? range_grid->count : 0)) {
+      error = "PLY header: obj_info num_cols and num_rows give a " +
+              std::to_string(header.grid_width) + " x " + std::to_string(header.grid_height) +
+              " grid for " + std::to_string(vertex->count) + " vertices";
+      return false;
+    }
+  }
   const std::streampos data_begins = in.tellg();
   if (data_begins < 0) { // end_header ends the file without a line break
     error = "truncated PLY file: the header's last line is cut short";

@@ -109,6 +109,10 @@ struct PlyHeader {
   std::uint64_t header_bytes = 0;
   /// PCL's reader takes a cloud's width and height from obj_info lines.
   bool has_obj_info = false;
+  /// The width and height PCL's reader gives the cloud by the end of the
+  /// header (obj_info num_cols and num_rows, else the vertex count by 1):
+  /// it sizes the vertex data for that many points.
+  std::uint32_t grid_width = 0, grid_height = 0;
 
   const PlyElement *find(const std::string &name) const {
     for (const PlyElement &element : elements)
