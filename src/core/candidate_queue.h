@@ -8,6 +8,7 @@
 #include <pcl_ms/scaffold.h> // CandidateIndex
 
 #include <boost/heap/d_ary_heap.hpp>
+#include <boost/sort/spreadsort/integer_sort.hpp>
 
 #include <algorithm>
 #include <cstdint>
@@ -25,6 +26,7 @@ namespace detail {
 /// per heap step instead of two float tests and a tie-break.
 class QueueEntry {
 public:
+  QueueEntry() = default; // for the sort's buffers
   QueueEntry(float cost, CandidateIndex candidate)
       : key_(std::uint64_t{bitsOf(cost)} << 32 | candidate) {}
   float cost() const {
@@ -34,6 +36,7 @@ public:
     return cost;
   }
   CandidateIndex candidate() const { return static_cast<CandidateIndex>(key_); }
+  std::uint64_t key() const { return key_; }
   // Boost's heaps keep the greatest element on top: "greater" puts the
   // cheapest first.
   bool operator>(const QueueEntry &other) const { return key_ > other.key_; }
@@ -46,7 +49,7 @@ private:
     return bits;
   }
 
-  std::uint64_t key_;
+  std::uint64_t key_ = 0;
 };
 
 struct CheaperFirst {
@@ -123,7 +126,18 @@ private:
       for (const QueueEntry &entry : arrived_)
         heap_.push(entry);
     } else {
-      std::sort(arrived_.begin(), arrived_.end());
+      // The keys are integers: Boost's radix sort takes 3 % less of the
+      // greedy than std::sort on PCL's scans (bench/README.md, session 38).
+      boost::sort::spreadsort::integer_sort(
+          arrived_.begin(), arrived_.end(),
+          [](const QueueEntry &entry, unsigned shift) { return entry.key() >> shift; },
+          [](const QueueEntry &a, const QueueEntry &b) { return a < b; });
+      if (next_ == sorted_.size()) { // nothing left to merge with: no copy
+        sorted_.swap(arrived_);
+        next_ = 0;
+        arrived_.clear();
+        return;
+      }
       std::vector<QueueEntry> merged;
       merged.reserve(sorted_.size() - next_ + arrived_.size());
       std::merge(sorted_.begin() + static_cast<std::ptrdiff_t>(next_), sorted_.end(),

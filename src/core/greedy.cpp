@@ -403,31 +403,34 @@ void GreedyMesher::Impl::accept(CandidateIndex t, bool created_second_fan) {
   states_[t].state = State::accepted;
   propagateContext(t, +1.0);
   for (VertexIndex v : candidates_[t].vertices) {
+    const bool was_multi_fan = multi_fan_vertex_[v];
     if (created_second_fan && mesh_.edgeTriangleCount(mesh_.edgesAt(t, v)[0]) == 1 &&
         mesh_.edgeTriangleCount(mesh_.edgesAt(t, v)[1]) == 1 && mesh_.vertexTriangleCount(v) > 1) {
       multi_fan_vertex_[v] = true;
       may_have_several_fans_[v] = true;
     }
+    // Every acceptance at a marked vertex is followed by this check and
+    // only an acceptance closes a ring, so a new one holds t inside it; an
+    // undo at t's other corners may have taken t out. A vertex marked just
+    // now may hold an older ring (docs/algorithm.md, section 3).
     if (multi_fan_vertex_[v])
-      keepClosedFanOnly(v);
+      keepClosedFanOnly(v, !was_multi_fan || (mesh_.contains(t) && mesh_.isInnerAt(t, v)));
   }
 }
 
 /// A vertex whose triangles form a closed ring plus other fans: the ring
-/// wins and the extras are undone.
-void GreedyMesher::Impl::keepClosedFanOnly(VertexIndex v) {
-  // A closed fan has at least three triangles whose both edges at v are
-  // full: without them there is nothing to do, and no fans to build.
+/// wins and the extras are undone. Without `may_have_new_ring` no ring can
+/// have closed since the last check: only the mark is updated.
+void GreedyMesher::Impl::keepClosedFanOnly(VertexIndex v, bool may_have_new_ring) {
+  // One fan: nothing to undo. The mark stays while fewer than three
+  // triangles are inside it (a closed fan has at least three).
   int inner_triangles = 0;
-  for (CandidateIndex u : mesh_.vertexTriangles(v))
-    inner_triangles += mesh_.isInnerAt(u, v);
-  if (inner_triangles < 3)
-    return;
-  if (mesh_.isSingleFan(v)) {
-    multi_fan_vertex_[v] = false;
+  if (mesh_.isSingleFan(v, inner_triangles)) {
+    if (inner_triangles >= 3)
+      multi_fan_vertex_[v] = false;
     return;
   }
-  if (!mesh_.hasClosedFan(v)) // the common case: no need to build the fans
+  if (!may_have_new_ring || !mesh_.hasClosedFan(v)) // the common case: no need to build the fans
     return;
   const auto fans = mesh_.fansAround(v);
   const std::vector<CandidateIndex> *closed = nullptr;

@@ -157,7 +157,7 @@ private:
   void delay(CandidateIndex t, State from, PassStatistics &statistics);
   bool closeCompetitorDelayed(CandidateIndex t, State queue);
   void accept(CandidateIndex t, bool created_second_fan);
-  void keepClosedFanOnly(VertexIndex v);
+  void keepClosedFanOnly(VertexIndex v, bool may_have_new_ring);
   void removeFromMesh(CandidateIndex t);
   void undo(CandidateIndex t);
   void removeFlapsAndIsolatedTriangles();

@@ -87,14 +87,22 @@ std::vector<std::vector<CandidateIndex>> MeshTopology::fansAround(VertexIndex v)
 }
 
 bool MeshTopology::isSingleFan(VertexIndex v) const {
+  int inner_triangles = 0;
+  return isSingleFan(v, inner_triangles);
+}
+
+bool MeshTopology::isSingleFan(VertexIndex v, int &inner_triangles) const {
   const VertexTriangles &around = vertex_triangles_[v];
-  if (around.size() <= 1)
+  inner_triangles = 0;
+  if (around.empty())
     return true;
   // With at most two triangles per edge, the triangles at v chained through
   // their edges at v form paths and cycles: walk both ways from the first.
   const CandidateIndex start = around[0];
+  const auto start_edges = edgesAt(start, v);
+  inner_triangles = isInner(start_edges);
   std::size_t reached = 1;
-  for (EdgeIndex first_edge : edgesAt(start, v)) {
+  for (EdgeIndex first_edge : start_edges) {
     CandidateIndex current = start;
     EdgeIndex through = first_edge;
     for (;;) {
@@ -105,6 +113,7 @@ bool MeshTopology::isSingleFan(VertexIndex v) const {
         return reached == around.size();
       ++reached;
       const auto edges = edgesAt(next, v);
+      inner_triangles += isInner(edges);
       through = edges[0] == through ? edges[1] : edges[0];
       current = next;
     }

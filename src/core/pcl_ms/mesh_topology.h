@@ -82,15 +82,15 @@ public:
   /// Whether v's triangles (if any) form one fan: fansAround(v).size() <= 1,
   /// found by walking the fan without building it.
   bool isSingleFan(VertexIndex v) const;
+  /// The same; when it returns true the walk has seen every triangle at v,
+  /// and `inner_triangles` counts those inside the fan (isInnerAt).
+  bool isSingleFan(VertexIndex v, int &inner_triangles) const;
   /// Whether one of v's fans is closed (a ring of inner triangles, see
   /// isInnerAt), found by walking without building the fans.
   bool hasClosedFan(VertexIndex v) const;
   /// Whether both of t's edges at v hold two triangles: t is inside v's
   /// fan, not at its rim.
-  bool isInnerAt(CandidateIndex t, VertexIndex v) const {
-    const auto edges = edgesAt(t, v);
-    return edgeTriangleCount(edges[0]) == 2 && edgeTriangleCount(edges[1]) == 2;
-  }
+  bool isInnerAt(CandidateIndex t, VertexIndex v) const { return isInner(edgesAt(t, v)); }
 
   /// The two edges of candidate t that contain vertex v; std::logic_error
   /// when v is not a corner of t. Inline: the greedy's rules ask it on
@@ -121,6 +121,11 @@ public:
   }
 
 private:
+  /// Whether both edges of a triangle at a vertex hold two triangles.
+  bool isInner(const std::array<EdgeIndex, 2> &edges_at_vertex) const {
+    return edgeTriangleCount(edges_at_vertex[0]) == 2 && edgeTriangleCount(edges_at_vertex[1]) == 2;
+  }
+
   /// Callers walk the triangles around v; anything else is a broken
   /// invariant, which must stop the run rather than quietly use some edge.
   [[noreturn]] static void notACorner(CandidateIndex t, VertexIndex v);
