@@ -457,7 +457,7 @@ TEST(MeshTopology, SingleAndClosedFanTestsAgreeWithTheFans) {
   triangles.push_back({0, 7, 8});
   triangles.push_back({0, 8, 9});
   const MedialScaffold scaffold = scaffoldOfTriangles(triangles);
-  int several_fans = 0, closed_beside_others = 0;
+  int several_fans = 0, closed_beside_others = 0, one_fan_three_inside = 0;
   for (unsigned subset = 0; subset < (1u << triangles.size()); ++subset) {
     MeshTopology mesh(scaffold, 10);
     for (CandidateIndex t = 0; t < triangles.size(); ++t)
@@ -466,6 +466,15 @@ TEST(MeshTopology, SingleAndClosedFanTestsAgreeWithTheFans) {
     for (VertexIndex v = 0; v < 10; ++v) {
       const auto fans = mesh.fansAround(v);
       ASSERT_EQ(mesh.isSingleFan(v), fans.size() <= 1) << "vertex " << v << ", subset " << subset;
+      // Where there is one fan, the walk counts the triangles inside it.
+      int inner_counted = -1;
+      if (mesh.isSingleFan(v, inner_counted)) {
+        int inner = 0;
+        for (CandidateIndex t : mesh.vertexTriangles(v))
+          inner += mesh.isInnerAt(t, v);
+        ASSERT_EQ(inner_counted, inner) << "vertex " << v << ", subset " << subset;
+        one_fan_three_inside += inner >= 3;
+      }
       bool closed = false;
       for (const auto &fan : fans)
         closed |= std::all_of(fan.begin(), fan.end(), [&](CandidateIndex t) {
@@ -481,6 +490,10 @@ TEST(MeshTopology, SingleAndClosedFanTestsAgreeWithTheFans) {
   // the closed ring meets the open fan in three subsets.
   EXPECT_GT(several_fans, 100);
   EXPECT_EQ(closed_beside_others, 3);
+  // One fan with three or more inside: at the centre, the whole ring (six
+  // inside) or the ring less one triangle (five in a row, three inside),
+  // without the open fan.
+  EXPECT_EQ(one_fan_three_inside, 7);
 }
 
 // ---- greedy ------------------------------------------------------------------------
