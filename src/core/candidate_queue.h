@@ -126,8 +126,8 @@ private:
       for (const QueueEntry &entry : arrived_)
         heap_.push(entry);
     } else {
-      // The keys are integers: Boost's radix sort takes 3 % less of the
-      // greedy than std::sort on PCL's scans (bench/README.md, session 38).
+      // The keys are integers: Boost's radix sort sorts them faster than
+      // std::sort (bench/README.md, "The greedy's rings and queue").
       boost::sort::spreadsort::integer_sort(
           arrived_.begin(), arrived_.end(),
           [](const QueueEntry &entry, unsigned shift) { return entry.key() >> shift; },
