@@ -7,7 +7,6 @@
 
 #include <pcl_ms/scaffold.h> // CandidateIndex
 
-#include <boost/heap/d_ary_heap.hpp>
 #include <boost/sort/spreadsort/integer_sort.hpp>
 
 #include <algorithm>
@@ -37,9 +36,6 @@ public:
   }
   CandidateIndex candidate() const { return static_cast<CandidateIndex>(key_); }
   std::uint64_t key() const { return key_; }
-  // Boost's heaps keep the greatest element on top: "greater" puts the
-  // cheapest first.
-  bool operator>(const QueueEntry &other) const { return key_ > other.key_; }
   bool operator<(const QueueEntry &other) const { return key_ < other.key_; }
 
 private:
@@ -52,16 +48,80 @@ private:
   std::uint64_t key_ = 0;
 };
 
-struct CheaperFirst {
-  bool operator()(const QueueEntry &a, const QueueEntry &b) const { return a > b; }
+/// A 4-ary min-heap of queue entries. Boost's d-ary heap finds a node's
+/// cheapest child with a branch per child, which the unordered costs
+/// mispredict about half the time: that search was two thirds of the pass
+/// loop's own time on PCL's scans. Here the child is chosen by comparisons
+/// that compile to conditional moves, and a pop takes the hole down to a
+/// leaf before placing the last entry, which belongs near the bottom
+/// (bench/README.md, "The heap without branches").
+class EntryHeap {
+public:
+  bool empty() const { return entries_.empty(); }
+  std::size_t size() const { return entries_.size(); }
+  const QueueEntry &top() const { return entries_.front(); }
+  std::vector<QueueEntry>::const_iterator begin() const { return entries_.begin(); }
+  std::vector<QueueEntry>::const_iterator end() const { return entries_.end(); }
+  void clear() { entries_.clear(); }
+  void reserve(std::size_t count) { entries_.reserve(count); }
+
+  void push(const QueueEntry &entry) {
+    entries_.push_back(entry);
+    placeFrom(entries_.size() - 1, entry);
+  }
+
+  void pop() {
+    const QueueEntry last = entries_.back();
+    entries_.pop_back();
+    const std::size_t count = entries_.size();
+    if (count == 0)
+      return;
+    std::size_t hole = 0;
+    for (;;) {
+      const std::size_t first = 4 * hole + 1;
+      std::size_t child;
+      if (first + 3 < count) {
+        const QueueEntry *children = &entries_[first];
+        const std::size_t low = children[1] < children[0] ? 1 : 0;
+        const std::size_t high = children[3] < children[2] ? 3 : 2;
+        child = first + (children[high] < children[low] ? high : low);
+      } else if (first < count) {
+        child = first;
+        for (std::size_t other = first + 1; other < count; ++other)
+          if (entries_[other] < entries_[child])
+            child = other;
+      } else {
+        break;
+      }
+      entries_[hole] = entries_[child];
+      hole = child;
+    }
+    placeFrom(hole, last);
+  }
+
+private:
+  /// Puts `entry` into the hole at `hole`, or above it while its parent
+  /// costs more.
+  void placeFrom(std::size_t hole, const QueueEntry &entry) {
+    while (hole > 0) {
+      const std::size_t parent = (hole - 1) / 4;
+      if (!(entry < entries_[parent]))
+        break;
+      entries_[hole] = entries_[parent];
+      hole = parent;
+    }
+    entries_[hole] = entry;
+  }
+
+  std::vector<QueueEntry> entries_;
 };
 
 /// The queue of one pass. Most entries arrive together before the pass
 /// pops any (the pass's initial costs): those are sorted once and read in
 /// order, which costs far less than sifting each through a heap of millions
 /// of entries, the greedy's main cost at 300,000 points. Entries pushed while
-/// the pass runs (changed costs) go to a small heap. Boost's contiguous d-ary
-/// heap has no handles: a candidate whose cost changes is pushed again and
+/// the pass runs (changed costs) go to a small heap. The heap has no
+/// handles: a candidate whose cost changes is pushed again and
 /// its outdated entry skipped when it surfaces (lazy deletion). Entries are
 /// totally ordered, so the pops come in the same order as from one heap.
 class CandidateQueue {
@@ -151,8 +211,7 @@ private:
   std::vector<QueueEntry> arrived_; // pushed, not yet placed
   std::vector<QueueEntry> sorted_;  // ascending from next_
   std::size_t next_ = 0;
-  boost::heap::d_ary_heap<QueueEntry, boost::heap::arity<4>, boost::heap::compare<CheaperFirst>>
-      heap_;
+  EntryHeap heap_;
 };
 
 } // namespace detail
