@@ -96,6 +96,11 @@ bool MeshTopology::isSingleFan(VertexIndex v, int &inner_triangles) const {
   inner_triangles = 0;
   if (around.empty())
     return true;
+  // More than two boundary edges: at least two fans that are not rings. Most
+  // of the greedy's marked vertices are such; no walk for them
+  // (docs/algorithm.md, section 3).
+  if (vertex_counts_[v].boundary_edges > 2)
+    return false;
   // With at most two triangles per edge, the triangles at v chained through
   // their edges at v form paths and cycles: walk both ways from the first.
   const CandidateIndex start = around[0];

@@ -80,7 +80,9 @@ public:
   /// each fan in ascending triangle order, fans ordered by first triangle.
   std::vector<std::vector<CandidateIndex>> fansAround(VertexIndex v) const;
   /// Whether v's triangles (if any) form one fan: fansAround(v).size() <= 1,
-  /// found by walking the fan without building it.
+  /// found by walking the fan without building it, or without a walk where
+  /// v has more than two boundary edges: each fan that is not a ring has
+  /// two, so there are several.
   bool isSingleFan(VertexIndex v) const;
   /// The same; when it returns true the walk has seen every triangle at v,
   /// and `inner_triangles` counts those inside the fan (isInnerAt).
