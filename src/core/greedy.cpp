@@ -412,16 +412,21 @@ void GreedyMesher::Impl::accept(CandidateIndex t, bool created_second_fan) {
     // Every acceptance at a marked vertex is followed by this check and
     // only an acceptance closes a ring, so a new one holds t inside it; an
     // undo at t's other corners may have taken t out. A vertex marked just
-    // now may hold an older ring (docs/algorithm.md, section 3).
+    // now may hold an older ring anywhere (docs/algorithm.md, section 3).
     if (multi_fan_vertex_[v])
-      keepClosedFanOnly(v, !was_multi_fan || (mesh_.contains(t) && mesh_.isInnerAt(t, v)));
+      keepClosedFanOnly(v,
+                        !was_multi_fan                               ? RingSearch::all_triangles
+                        : mesh_.contains(t) && mesh_.isInnerAt(t, v) ? RingSearch::through_accepted
+                                                                     : RingSearch::none,
+                        t);
   }
 }
 
 /// A vertex whose triangles form a closed ring plus other fans: the ring
-/// wins and the extras are undone. Without `may_have_new_ring` no ring can
-/// have closed since the last check: only the mark is updated.
-void GreedyMesher::Impl::keepClosedFanOnly(VertexIndex v, bool may_have_new_ring) {
+/// wins and the extras are undone. `search` says where a ring may have
+/// closed since the last check; with none, only the mark is updated.
+void GreedyMesher::Impl::keepClosedFanOnly(VertexIndex v, RingSearch search,
+                                           CandidateIndex accepted) {
   // One fan: nothing to undo. The mark stays while fewer than three
   // triangles are inside it (a closed fan has at least three).
   int inner_triangles = 0;
@@ -430,7 +435,11 @@ void GreedyMesher::Impl::keepClosedFanOnly(VertexIndex v, bool may_have_new_ring
       multi_fan_vertex_[v] = false;
     return;
   }
-  if (!may_have_new_ring || !mesh_.hasClosedFan(v)) // the common case: no need to build the fans
+  const bool has_closed_fan = search == RingSearch::all_triangles ? mesh_.hasClosedFan(v)
+                              : search == RingSearch::through_accepted
+                                  ? mesh_.isInClosedFan(accepted, v)
+                                  : false;
+  if (!has_closed_fan) // the common case: no need to build the fans
     return;
   const auto fans = mesh_.fansAround(v);
   const std::vector<CandidateIndex> *closed = nullptr;

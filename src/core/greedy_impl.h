@@ -157,7 +157,10 @@ private:
   void delay(CandidateIndex t, State from, PassStatistics &statistics);
   bool closeCompetitorDelayed(CandidateIndex t, State queue);
   void accept(CandidateIndex t, bool created_second_fan);
-  void keepClosedFanOnly(VertexIndex v, bool may_have_new_ring);
+  /// Where keepClosedFanOnly looks for a ring that closed since the last
+  /// check at the vertex.
+  enum class RingSearch { none, through_accepted, all_triangles };
+  void keepClosedFanOnly(VertexIndex v, RingSearch search, CandidateIndex accepted);
   void removeFromMesh(CandidateIndex t);
   void undo(CandidateIndex t);
   void removeFlapsAndIsolatedTriangles();

@@ -127,25 +127,27 @@ bool MeshTopology::isSingleFan(VertexIndex v, int &inner_triangles) const {
 }
 
 bool MeshTopology::hasClosedFan(VertexIndex v) const {
+  return std::any_of(vertex_triangles_[v].begin(), vertex_triangles_[v].end(),
+                     [&](CandidateIndex start) { return isInClosedFan(start, v); });
+}
+
+bool MeshTopology::isInClosedFan(CandidateIndex t, VertexIndex v) const {
   // Inner triangles link to two others at v: a walk from one returns to it
   // exactly when its fan is a ring of inner triangles.
-  for (CandidateIndex start : vertex_triangles_[v]) {
-    if (!isInnerAt(start, v))
-      continue;
-    CandidateIndex current = start;
-    EdgeIndex through = edgesAt(start, v)[0];
-    for (;;) {
-      const CandidateIndex next = otherTriangle(through, current);
-      if (next == start)
-        return true;
-      if (!isInnerAt(next, v))
-        break;
-      const auto edges = edgesAt(next, v);
-      through = edges[0] == through ? edges[1] : edges[0];
-      current = next;
-    }
+  if (!isInnerAt(t, v))
+    return false;
+  CandidateIndex current = t;
+  EdgeIndex through = edgesAt(t, v)[0];
+  for (;;) {
+    const CandidateIndex next = otherTriangle(through, current);
+    if (next == t)
+      return true;
+    if (!isInnerAt(next, v))
+      return false;
+    const auto edges = edgesAt(next, v);
+    through = edges[0] == through ? edges[1] : edges[0];
+    current = next;
   }
-  return false;
 }
 
 } // namespace pcl_ms

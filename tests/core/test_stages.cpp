@@ -476,11 +476,17 @@ TEST(MeshTopology, SingleAndClosedFanTestsAgreeWithTheFans) {
         one_fan_three_inside += inner >= 3;
       }
       bool closed = false;
-      for (const auto &fan : fans)
-        closed |= std::all_of(fan.begin(), fan.end(), [&](CandidateIndex t) {
+      for (const auto &fan : fans) {
+        const bool fan_closed = std::all_of(fan.begin(), fan.end(), [&](CandidateIndex t) {
           const auto edges = mesh.edgesAt(t, v);
           return mesh.edgeTriangleCount(edges[0]) == 2 && mesh.edgeTriangleCount(edges[1]) == 2;
         });
+        // The walk from one triangle finds its own fan's ring only.
+        for (CandidateIndex t : fan)
+          ASSERT_EQ(mesh.isInClosedFan(t, v), fan_closed)
+              << "triangle " << t << ", vertex " << v << ", subset " << subset;
+        closed |= fan_closed;
+      }
       ASSERT_EQ(mesh.hasClosedFan(v), closed) << "vertex " << v << ", subset " << subset;
       closed_beside_others += closed && fans.size() > 1;
     }

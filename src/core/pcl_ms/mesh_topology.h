@@ -90,6 +90,8 @@ public:
   /// Whether one of v's fans is closed (a ring of inner triangles, see
   /// isInnerAt), found by walking without building the fans.
   bool hasClosedFan(VertexIndex v) const;
+  /// Whether t lies in a closed fan of v: one walk from t.
+  bool isInClosedFan(CandidateIndex t, VertexIndex v) const;
   /// Whether both of t's edges at v hold two triangles: t is inside v's
   /// fan, not at its rim.
   bool isInnerAt(CandidateIndex t, VertexIndex v) const { return isInner(edgesAt(t, v)); }
