@@ -144,10 +144,10 @@ std::optional<Circle> circumcircle(const Eigen::Vector3d &a, const EdgeVectors &
   return circle;
 }
 
-// The candidate loop reads a facet's corners from the points (by index), not
-// from the vertex records: it fetches the corner points of the cell this many
-// steps ahead, whose vertices prefetchNeighbours has fetched by then.
-constexpr std::size_t corner_prefetch_distance = 4;
+// The candidates' pass reads the corner points and scales of the facets, in
+// the triangulation's cell order: it fetches those of the facet this many
+// steps ahead.
+constexpr std::size_t corner_prefetch_distance = 8;
 
 // Cells are visited in memory order, but their neighbours, which every
 // facet test reads, lie anywhere: fetching the neighbours of the cell this
@@ -165,18 +165,6 @@ constexpr std::size_t neighbour_prefetch_distance = 8;
     __builtin_prefetch(neighbour);
     __builtin_prefetch(neighbour + 64);
     __builtin_prefetch(&*cells[index]->vertex(i));
-  }
-}
-
-[[gnu::always_inline]] inline void
-prefetchCornerPoints(const std::vector<CellHandle> &cells, std::size_t index,
-                     VertexHandle infinite_vertex, const std::vector<Eigen::Vector3d> &points) {
-  if (index >= cells.size())
-    return;
-  for (int i = 0; i < 4; ++i) {
-    const VertexHandle vertex = cells[index]->vertex(i);
-    if (vertex != infinite_vertex)
-      __builtin_prefetch(&points[vertex->info()]);
   }
 }
 
@@ -205,7 +193,19 @@ template <typename Iterator> float medianOf(Iterator first, Iterator last) {
 double median(std::vector<float> &values) { return medianOf(values.begin(), values.end()); }
 
 /// What the local scales' pass finds out about a facet, for the candidates'.
-enum class FacetKind : std::uint8_t { collinear, gabriel, other };
+/// The Gabriel facets of a 3-D triangulation come out typed (acute, obtuse)
+/// with their shock length, or as circleless where their circumcircle does
+/// not exist in double precision from the sorted corners.
+enum class FacetKind : std::uint8_t { collinear, acute, obtuse, circleless, gabriel_planar, other };
+
+/// The finite facets of one chunk of cells, in the order visited: what the
+/// candidates' pass reads instead of the triangulation, so that it runs
+/// after the tetrahedra are freed.
+struct ChunkFacets {
+  std::vector<Triangle> corners; // ascending
+  std::vector<FacetKind> kinds;
+  std::vector<double> shock_lengths; // one per acute or obtuse facet
+};
 
 // |u x v|^2 above this times |u|^2 |v|^2 (a sine above 1e-10) cannot come
 // from rounding (about 1e-15 relative): those facets skip the exact test.
@@ -266,12 +266,12 @@ public:
 
     collectCells(delaunay);
     measureLocalScales(delaunay);
-    buildCandidates(delaunay);
-    // The tetrahedra are no longer needed: free them before the edge graph.
+    // The facets are listed: the tetrahedra are no longer needed.
     cells_.clear();
     cells_.shrink_to_fit();
-    chunk_kinds_ = {};
     delaunay.clear();
+    buildCandidates();
+    chunk_facets_ = {};
     if (options_.fixed_triangles)
       addFixedTriangles(*options_.fixed_triangles);
     if (options_.preferred_triangles)
@@ -352,17 +352,21 @@ private:
       float circumradius;
     };
     std::vector<std::vector<GabrielTriangle>> chunk_triangles(chunkCount(cells_.size()));
-    chunk_kinds_.assign(chunkCount(cells_.size()), {});
+    chunk_facets_.assign(chunkCount(cells_.size()), {});
     forEachChunk(
         cells_.size(), options_.num_threads,
         [&](std::size_t chunk, std::size_t begin, std::size_t end) {
           auto &gabriel = chunk_triangles[chunk];
-          std::vector<FacetKind> &kinds = chunk_kinds_[chunk];
+          ChunkFacets &facets = chunk_facets_[chunk];
+          std::vector<FacetKind> &kinds = facets.kinds;
           for (std::size_t index = begin; index < end; ++index) {
             if (!scaffold_.planar)
               prefetchNeighbours(cells_, index + neighbour_prefetch_distance);
             forEachOwnedFacet(
                 delaunay, cells_[index], [&](CellHandle cell, int i, const auto &vertices) {
+                  Triangle sorted = {vertices[0]->info(), vertices[1]->info(), vertices[2]->info()};
+                  std::sort(sorted.begin(), sorted.end());
+                  facets.corners.push_back(sorted);
                   const KernelPoint &a = vertices[0]->point(), &b = vertices[1]->point(),
                                     &c = vertices[2]->point();
                   const Eigen::Vector3d p = toEigen(a);
@@ -384,12 +388,16 @@ private:
                       (edges.uu + edges.vv + (edges.v - edges.u).squaredNorm());
                   const bool is_gabriel = scaffold_.planar || isGabriel(delaunay, cell, i, vertices,
                                                                         circle, compactness);
-                  kinds.push_back(is_gabriel ? FacetKind::gabriel : FacetKind::other);
-                  if (!is_gabriel)
+                  if (!is_gabriel) {
+                    kinds.push_back(FacetKind::other);
                     return;
+                  }
                   gabriel.push_back(
                       {{vertices[0]->info(), vertices[1]->info(), vertices[2]->info()},
                        static_cast<float>(circle.radius)});
+                  kinds.push_back(scaffold_.planar ? FacetKind::gabriel_planar
+                                                   : typeGabriel(delaunay, cell, i, sorted,
+                                                                 vertices, facets.shock_lengths));
                 });
           }
         });
@@ -521,6 +529,21 @@ private:
     }
   }
 
+  /// The type of a Gabriel facet of a 3-D triangulation, appending its shock
+  /// length to `shock_lengths` where it has one. Its circle is computed again
+  /// from the corners in ascending order, as its cost is: from other corners
+  /// than the Gabriel test's, it may be missing where that one's was found.
+  FacetKind typeGabriel(const Delaunay &delaunay, CellHandle cell, int i, const Triangle &sorted,
+                        const std::array<VertexHandle, 3> &handles,
+                        std::vector<double> &shock_lengths) const {
+    const Eigen::Vector3d &a = points_[sorted[0]], &b = points_[sorted[1]], &c = points_[sorted[2]];
+    const std::optional<Circle> found = circumcircle(a, EdgeVectors(a, b, c));
+    if (!found)
+      return FacetKind::circleless;
+    shock_lengths.push_back(shockLength(delaunay, cell, i, *found));
+    return allAnglesAcute(a, b, c, handles) ? FacetKind::acute : FacetKind::obtuse;
+  }
+
   /// The shorter piece of the dual Voronoi edge cut by the circumcentre.
   double shockLength(const Delaunay &delaunay, CellHandle cell, int i, const Circle &circle) const {
     double shortest = std::numeric_limits<double>::infinity();
@@ -549,93 +572,82 @@ private:
     return usable ? sum / usable : 1.0;
   }
 
-  void buildCandidates(const Delaunay &delaunay) {
-    std::vector<ChunkCandidates> chunks(chunkCount(cells_.size()));
+  void buildCandidates() {
+    std::vector<ChunkCandidates> chunks(chunk_facets_.size());
     const std::vector<float> &scale = scaffold_.local_scale;
-    forEachChunk(
-        cells_.size(), options_.num_threads,
-        [&](std::size_t chunk, std::size_t begin, std::size_t end) {
-          ChunkCandidates &out = chunks[chunk];
-          // The facets come in the order measureLocalScales saw them in, one
-          // kind each: room for all of them spares the list's regrowth.
-          std::vector<FacetKind>::const_iterator kind = chunk_kinds_[chunk].begin();
-          out.candidates.reserve(chunk_kinds_[chunk].size());
-          for (std::size_t index = begin; index < end; ++index) {
-            if (!scaffold_.planar) {
-              prefetchNeighbours(cells_, index + neighbour_prefetch_distance);
-              prefetchCornerPoints(cells_, index + corner_prefetch_distance,
-                                   delaunay.infinite_vertex(), points_);
+    detail::withThreads(options_.num_threads, [&] {
+      detail::parallelFor(std::size_t(0), chunks.size(), [&](std::size_t chunk) {
+        ChunkCandidates &out = chunks[chunk];
+        const ChunkFacets &facets = chunk_facets_[chunk];
+        // Room for every facet spares the list's regrowth.
+        out.candidates.reserve(facets.kinds.size());
+        std::vector<double>::const_iterator next_shock_length = facets.shock_lengths.begin();
+        for (std::size_t f = 0; f < facets.kinds.size(); ++f) {
+          if (f + corner_prefetch_distance < facets.corners.size())
+            for (VertexIndex corner : facets.corners[f + corner_prefetch_distance]) {
+              __builtin_prefetch(&points_[corner]);
+              __builtin_prefetch(&scale[corner]);
             }
-            forEachOwnedFacet(
-                delaunay, cells_[index],
-                [&](CellHandle cell, int i, const std::array<VertexHandle, 3> &handles) {
-                  const FacetKind facet_kind = *kind++;
-                  const bool gabriel = facet_kind == FacetKind::gabriel;
-                  Candidate candidate;
-                  for (int k = 0; k < 3; ++k)
-                    candidate.vertices[k] = handles[k]->info();
-                  if (touchesFrozenVertex(candidate.vertices))
-                    return;
-                  std::sort(candidate.vertices.begin(), candidate.vertices.end());
-                  const Eigen::Vector3d &a = points_[candidate.vertices[0]],
-                                        &b = points_[candidate.vertices[1]],
-                                        &c = points_[candidate.vertices[2]];
-                  // About half the facets of a surface sample's tetrahedra are
-                  // too long: the cheap length test comes first.
-                  const double local_scale = triangleScale(scale, candidate.vertices);
-                  const double max_side = options_.rho * local_scale;
-                  if (std::max({(b - a).squaredNorm(), (c - b).squaredNorm(),
-                                (a - c).squaredNorm()}) >= max_side * max_side) {
-                    ++out.oversize;
-                    return;
-                  }
-                  if (facet_kind == FacetKind::collinear) {
-                    ++out.degenerate;
-                    return;
-                  }
-                  const TriangleShape shape = triangleShape(a, b, c);
-                  // Types I and II measure their shock from the circle;
-                  // type III needs it only for the normal term.
-                  const bool needs_circle = (gabriel && !scaffold_.planar) || options_.normals;
-                  // From other corners than the local scales' pass: it may
-                  // be missing where that one's was found.
-                  const std::optional<Circle> found =
-                      needs_circle ? circumcircle(a, EdgeVectors(a, b, c)) : Circle{};
-                  if (!found) {
-                    ++out.degenerate;
-                    return;
-                  }
-                  const Circle &circle = *found;
-                  double shock_length;
-                  if (scaffold_.planar) {
-                    // Both Voronoi pieces are infinite in a plane: rank by shape and size.
-                    candidate.type = CandidateType::acute;
-                    shock_length = local_scale;
-                  } else if (gabriel) {
-                    candidate.type = allAnglesAcute(a, b, c, handles) ? CandidateType::acute
-                                                                      : CandidateType::obtuse;
-                    shock_length = shockLength(delaunay, cell, i, circle);
-                  } else {
-                    // Type III has no A1^3-2 point on its curve: use the local spacing.
-                    candidate.type = CandidateType::ambiguous;
-                    shock_length = local_scale;
-                  }
-                  shock_length = std::max(shock_length, min_shock_length_fraction * local_scale);
-                  const double compactness_squared = shape.compactness * shape.compactness;
-                  double base_cost = baseCost(shape.perimeter, shock_length, shape.compactness);
-                  if (options_.normals)
-                    base_cost *=
-                        1.0 + options_.normal_weight *
-                                  (1.0 - normalAgreement(candidate.vertices, circle.unit_normal));
-                  candidate.base_cost = static_cast<float>(base_cost);
-                  candidate.inverse_shock_compactness =
-                      static_cast<float>(1.0 / (shock_length * compactness_squared));
-                  candidate.edges = {0, 0, 0};
-                  ++out.type_counts[static_cast<int>(candidate.type)];
-                  out.candidates.push_back(candidate);
-                });
+          const FacetKind facet_kind = facets.kinds[f];
+          const bool typed = facet_kind == FacetKind::acute || facet_kind == FacetKind::obtuse;
+          const double measured_shock_length = typed ? *next_shock_length++ : 0.0;
+          Candidate candidate;
+          candidate.vertices = facets.corners[f];
+          if (touchesFrozenVertex(candidate.vertices))
+            continue;
+          const Eigen::Vector3d &a = points_[candidate.vertices[0]],
+                                &b = points_[candidate.vertices[1]],
+                                &c = points_[candidate.vertices[2]];
+          // About half the facets of a surface sample's tetrahedra are too
+          // long: the cheap length test comes first.
+          const double local_scale = triangleScale(scale, candidate.vertices);
+          const double max_side = options_.rho * local_scale;
+          if (std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()}) >=
+              max_side * max_side) {
+            ++out.oversize;
+            continue;
           }
-        });
+          if (facet_kind == FacetKind::collinear || facet_kind == FacetKind::circleless) {
+            ++out.degenerate;
+            continue;
+          }
+          const TriangleShape shape = triangleShape(a, b, c);
+          // The normal term needs the circle's normal.
+          const std::optional<Circle> found =
+              options_.normals ? circumcircle(a, EdgeVectors(a, b, c)) : Circle{};
+          if (!found) {
+            ++out.degenerate;
+            continue;
+          }
+          double shock_length;
+          if (typed) {
+            candidate.type =
+                facet_kind == FacetKind::acute ? CandidateType::acute : CandidateType::obtuse;
+            shock_length = measured_shock_length;
+          } else if (facet_kind == FacetKind::gabriel_planar) {
+            // Both Voronoi pieces are infinite in a plane: rank by shape and size.
+            candidate.type = CandidateType::acute;
+            shock_length = local_scale;
+          } else {
+            // Type III has no A1^3-2 point on its curve: use the local spacing.
+            candidate.type = CandidateType::ambiguous;
+            shock_length = local_scale;
+          }
+          shock_length = std::max(shock_length, min_shock_length_fraction * local_scale);
+          const double compactness_squared = shape.compactness * shape.compactness;
+          double base_cost = baseCost(shape.perimeter, shock_length, shape.compactness);
+          if (options_.normals)
+            base_cost *= 1.0 + options_.normal_weight *
+                                   (1.0 - normalAgreement(candidate.vertices, found->unit_normal));
+          candidate.base_cost = static_cast<float>(base_cost);
+          candidate.inverse_shock_compactness =
+              static_cast<float>(1.0 / (shock_length * compactness_squared));
+          candidate.edges = {0, 0, 0};
+          ++out.type_counts[static_cast<int>(candidate.type)];
+          out.candidates.push_back(candidate);
+        }
+      });
+    });
     std::size_t total = 0;
     for (const auto &chunk : chunks)
       total += chunk.candidates.size();
@@ -835,9 +847,9 @@ private:
   const ScaffoldOptions &options_;
   MedialScaffold scaffold_;
   std::vector<CellHandle> cells_;
-  /// Per chunk of cells, what each facet visited is (measured once for the
-  /// local scales, read again for the candidates).
-  std::vector<std::vector<FacetKind>> chunk_kinds_;
+  /// Per chunk of cells, its facets as the local scales' pass found them,
+  /// for the candidates' pass.
+  std::vector<ChunkFacets> chunk_facets_;
 };
 
 } // namespace
