@@ -242,11 +242,14 @@ bool allAnglesAcute(const Eigen::Vector3d &a, const Eigen::Vector3d &b, const Ei
          CGAL::angle(handles[1]->point(), handles[2]->point(), handles[0]->point()) == CGAL::ACUTE;
 }
 
-/// Per-chunk output of the candidate pass.
-struct ChunkCandidates {
-  std::vector<Candidate> candidates;
-  std::size_t type_counts[4] = {0, 0, 0, 0};
-  std::size_t oversize = 0, degenerate = 0;
+/// What the candidates' pass makes of a facet, decided before any is costed
+/// so that each candidate is written once, in its final place.
+enum class FacetFate : std::uint8_t { left_out, oversize, degenerate, gabriel, ambiguous };
+
+/// Per chunk of facets: each one's fate and how many have each.
+struct ChunkFates {
+  std::vector<FacetFate> fates;
+  std::size_t counts[5] = {0, 0, 0, 0, 0}; // by FacetFate
 };
 
 class ScaffoldBuilder {
@@ -572,102 +575,133 @@ private:
     return usable ? sum / usable : 1.0;
   }
 
+  /// The candidates, types I and II first (pass 1 of the greedy touches only
+  /// them, so its working set is a contiguous part of the list), each group
+  /// in the facets' order. Two steps over the facets: their fates, then the
+  /// costs of those that become candidates, each written once in its place.
+  /// A list per chunk copied into the whole one took longer: twice the fresh
+  /// memory, each page of it a fault (bench/README.md).
   void buildCandidates() {
-    std::vector<ChunkCandidates> chunks(chunk_facets_.size());
-    const std::vector<float> &scale = scaffold_.local_scale;
-    detail::withThreads(options_.num_threads, [&] {
-      detail::parallelFor(std::size_t(0), chunks.size(), [&](std::size_t chunk) {
-        ChunkCandidates &out = chunks[chunk];
-        const ChunkFacets &facets = chunk_facets_[chunk];
-        // Room for every facet spares the list's regrowth.
-        out.candidates.reserve(facets.kinds.size());
-        std::vector<double>::const_iterator next_shock_length = facets.shock_lengths.begin();
-        for (std::size_t f = 0; f < facets.kinds.size(); ++f) {
-          if (f + corner_prefetch_distance < facets.corners.size())
-            for (VertexIndex corner : facets.corners[f + corner_prefetch_distance]) {
-              __builtin_prefetch(&points_[corner]);
-              __builtin_prefetch(&scale[corner]);
-            }
-          const FacetKind facet_kind = facets.kinds[f];
-          const bool typed = facet_kind == FacetKind::acute || facet_kind == FacetKind::obtuse;
-          const double measured_shock_length = typed ? *next_shock_length++ : 0.0;
-          Candidate candidate;
-          candidate.vertices = facets.corners[f];
-          if (touchesFrozenVertex(candidate.vertices))
-            continue;
-          const Eigen::Vector3d &a = points_[candidate.vertices[0]],
-                                &b = points_[candidate.vertices[1]],
-                                &c = points_[candidate.vertices[2]];
-          // About half the facets of a surface sample's tetrahedra are too
-          // long: the cheap length test comes first.
-          const double local_scale = triangleScale(scale, candidate.vertices);
-          const double max_side = options_.rho * local_scale;
-          if (std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()}) >=
-              max_side * max_side) {
-            ++out.oversize;
-            continue;
-          }
-          if (facet_kind == FacetKind::collinear || facet_kind == FacetKind::circleless) {
-            ++out.degenerate;
-            continue;
-          }
-          const TriangleShape shape = triangleShape(a, b, c);
-          // The normal term needs the circle's normal.
-          const std::optional<Circle> found =
-              options_.normals ? circumcircle(a, EdgeVectors(a, b, c)) : Circle{};
-          if (!found) {
-            ++out.degenerate;
-            continue;
-          }
-          double shock_length;
-          if (typed) {
-            candidate.type =
-                facet_kind == FacetKind::acute ? CandidateType::acute : CandidateType::obtuse;
-            shock_length = measured_shock_length;
-          } else if (facet_kind == FacetKind::gabriel_planar) {
-            // Both Voronoi pieces are infinite in a plane: rank by shape and size.
-            candidate.type = CandidateType::acute;
-            shock_length = local_scale;
-          } else {
-            // Type III has no A1^3-2 point on its curve: use the local spacing.
-            candidate.type = CandidateType::ambiguous;
-            shock_length = local_scale;
-          }
-          shock_length = std::max(shock_length, min_shock_length_fraction * local_scale);
-          const double compactness_squared = shape.compactness * shape.compactness;
-          double base_cost = baseCost(shape.perimeter, shock_length, shape.compactness);
-          if (options_.normals)
-            base_cost *= 1.0 + options_.normal_weight *
-                                   (1.0 - normalAgreement(candidate.vertices, found->unit_normal));
-          candidate.base_cost = static_cast<float>(base_cost);
-          candidate.inverse_shock_compactness =
-              static_cast<float>(1.0 / (shock_length * compactness_squared));
-          candidate.edges = {0, 0, 0};
-          ++out.type_counts[static_cast<int>(candidate.type)];
-          out.candidates.push_back(candidate);
-        }
-      });
+    std::vector<ChunkFates> chunks(chunk_facets_.size());
+    forEachFacetChunk([&](std::size_t chunk) {
+      const ChunkFacets &facets = chunk_facets_[chunk];
+      ChunkFates &out = chunks[chunk];
+      out.fates.resize(facets.kinds.size());
+      for (std::size_t f = 0; f < facets.kinds.size(); ++f) {
+        prefetchCorners(facets, f + corner_prefetch_distance);
+        const FacetFate fate = fateOf(facets.corners[f], facets.kinds[f]);
+        out.fates[f] = fate;
+        ++out.counts[static_cast<int>(fate)];
+      }
     });
-    std::size_t total = 0;
-    for (const auto &chunk : chunks)
-      total += chunk.candidates.size();
-    scaffold_.candidates.reserve(total);
-    // Types I and II first: pass 1 touches only them, so its working set is
-    // a contiguous quarter of the candidates instead of being spread over all.
-    for (bool ambiguous : {false, true})
-      for (const auto &chunk : chunks)
-        std::copy_if(chunk.candidates.begin(), chunk.candidates.end(),
-                     std::back_inserter(scaffold_.candidates), [&](const Candidate &candidate) {
-                       return (candidate.type == CandidateType::ambiguous) == ambiguous;
-                     });
-    for (auto &chunk : chunks) {
-      scaffold_.type1 += chunk.type_counts[1];
-      scaffold_.type2 += chunk.type_counts[2];
-      scaffold_.type3 += chunk.type_counts[3];
-      scaffold_.oversize += chunk.oversize;
-      scaffold_.degenerate += chunk.degenerate;
-      chunk = ChunkCandidates();
+    // Where each chunk's candidates of either group start.
+    std::vector<std::size_t> gabriel_start(chunks.size()), ambiguous_start(chunks.size());
+    std::size_t gabriel_total = 0, ambiguous_total = 0;
+    for (std::size_t chunk = 0; chunk < chunks.size(); ++chunk) {
+      gabriel_start[chunk] = gabriel_total;
+      ambiguous_start[chunk] = ambiguous_total;
+      gabriel_total += chunks[chunk].counts[static_cast<int>(FacetFate::gabriel)];
+      ambiguous_total += chunks[chunk].counts[static_cast<int>(FacetFate::ambiguous)];
+      scaffold_.oversize += chunks[chunk].counts[static_cast<int>(FacetFate::oversize)];
+      scaffold_.degenerate += chunks[chunk].counts[static_cast<int>(FacetFate::degenerate)];
     }
+    std::vector<Candidate> &candidates = scaffold_.candidates;
+    candidates.resize(gabriel_total + ambiguous_total);
+    std::vector<std::array<std::size_t, 4>> type_counts(chunks.size(), {0, 0, 0, 0});
+    forEachFacetChunk([&](std::size_t chunk) {
+      const ChunkFacets &facets = chunk_facets_[chunk];
+      const std::vector<FacetFate> &fates = chunks[chunk].fates;
+      std::size_t next_gabriel = gabriel_start[chunk];
+      std::size_t next_ambiguous = gabriel_total + ambiguous_start[chunk];
+      std::vector<double>::const_iterator next_shock_length = facets.shock_lengths.begin();
+      for (std::size_t f = 0; f < fates.size(); ++f) {
+        const FacetKind kind = facets.kinds[f];
+        const bool typed = kind == FacetKind::acute || kind == FacetKind::obtuse;
+        const double measured_shock_length = typed ? *next_shock_length++ : 0.0;
+        if (fates[f] != FacetFate::gabriel && fates[f] != FacetFate::ambiguous)
+          continue;
+        prefetchCorners(facets, f + corner_prefetch_distance);
+        Candidate &candidate =
+            candidates[fates[f] == FacetFate::gabriel ? next_gabriel++ : next_ambiguous++];
+        cost(facets.corners[f], kind, measured_shock_length, candidate);
+        ++type_counts[chunk][static_cast<int>(candidate.type)];
+      }
+    });
+    for (const auto &counts : type_counts) {
+      scaffold_.type1 += counts[1];
+      scaffold_.type2 += counts[2];
+      scaffold_.type3 += counts[3];
+    }
+  }
+
+  template <typename ChunkWork> void forEachFacetChunk(const ChunkWork &work) const {
+    detail::withThreads(options_.num_threads,
+                        [&] { detail::parallelFor(std::size_t(0), chunk_facets_.size(), work); });
+  }
+
+  [[gnu::always_inline]] inline void prefetchCorners(const ChunkFacets &facets,
+                                                     std::size_t f) const {
+    if (f >= facets.corners.size())
+      return;
+    for (VertexIndex corner : facets.corners[f]) {
+      __builtin_prefetch(&points_[corner]);
+      __builtin_prefetch(&scaffold_.local_scale[corner]);
+    }
+  }
+
+  /// Whether a facet becomes a candidate, of which group, or why not.
+  FacetFate fateOf(const Triangle &corners, FacetKind kind) const {
+    if (touchesFrozenVertex(corners))
+      return FacetFate::left_out;
+    const Eigen::Vector3d &a = points_[corners[0]], &b = points_[corners[1]],
+                          &c = points_[corners[2]];
+    // About half the facets of a surface sample's tetrahedra are too long:
+    // the cheap length test comes first.
+    const double max_side = options_.rho * triangleScale(scaffold_.local_scale, corners);
+    if (std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()}) >=
+        max_side * max_side)
+      return FacetFate::oversize;
+    if (kind == FacetKind::collinear || kind == FacetKind::circleless)
+      return FacetFate::degenerate;
+    // The normal term needs the circle's normal.
+    if (options_.normals && !circumcircle(a, EdgeVectors(a, b, c)))
+      return FacetFate::degenerate;
+    return kind == FacetKind::other ? FacetFate::ambiguous : FacetFate::gabriel;
+  }
+
+  /// The type and costs of a facet whose fate is to be a candidate.
+  void cost(const Triangle &corners, FacetKind kind, double measured_shock_length,
+            Candidate &candidate) const {
+    candidate.vertices = corners;
+    const Eigen::Vector3d &a = points_[corners[0]], &b = points_[corners[1]],
+                          &c = points_[corners[2]];
+    const double local_scale = triangleScale(scaffold_.local_scale, corners);
+    const TriangleShape shape = triangleShape(a, b, c);
+    double shock_length;
+    if (kind == FacetKind::acute || kind == FacetKind::obtuse) {
+      candidate.type = kind == FacetKind::acute ? CandidateType::acute : CandidateType::obtuse;
+      shock_length = measured_shock_length;
+    } else if (kind == FacetKind::gabriel_planar) {
+      // Both Voronoi pieces are infinite in a plane: rank by shape and size.
+      candidate.type = CandidateType::acute;
+      shock_length = local_scale;
+    } else {
+      // Type III has no A1^3-2 point on its curve: use the local spacing.
+      candidate.type = CandidateType::ambiguous;
+      shock_length = local_scale;
+    }
+    shock_length = std::max(shock_length, min_shock_length_fraction * local_scale);
+    const double compactness_squared = shape.compactness * shape.compactness;
+    double base_cost = baseCost(shape.perimeter, shock_length, shape.compactness);
+    if (options_.normals) {
+      // Found: fateOf let the facet through only then.
+      const Eigen::Vector3d unit_normal = circumcircle(a, EdgeVectors(a, b, c))->unit_normal;
+      base_cost *= 1.0 + options_.normal_weight * (1.0 - normalAgreement(corners, unit_normal));
+    }
+    candidate.base_cost = static_cast<float>(base_cost);
+    candidate.inverse_shock_compactness =
+        static_cast<float>(1.0 / (shock_length * compactness_squared));
+    candidate.edges = {0, 0, 0};
   }
 
   bool touchesFrozenVertex(const std::array<VertexIndex, 3> &vertices) const {
