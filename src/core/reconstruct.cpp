@@ -317,7 +317,6 @@ Result meshPrepared(const PreparedPoints &prepared, const std::vector<Triangle> 
                     const Parameters &parameters, BucketExchange &exchange,
                     const Deadline &deadline, Clock::time_point start, Result result);
 
-/// The checks every entry point makes before any work.
 /// The medial axis of the finished surface, into `result` (Parameters::compute_medial_axis).
 void addMedialAxis(const PreparedPoints &prepared, const std::vector<Triangle> &triangles,
                    const Deadline &deadline, Result &result);
@@ -325,12 +324,22 @@ void addMedialAxis(const PreparedPoints &prepared, const std::vector<Triangle> &
 void takeFinishedSurface(FinishedSurface &&surface, const PreparedPoints &prepared, Result &result);
 /// The finished surface, whose numbers are the user's records, into `result`.
 void moveFinishedSurface(FinishedSurface &&surface, Result &result);
+/// The checks every entry point makes before any work.
 void checkParameters(const Parameters &parameters, bool has_normals) {
   const std::string invalid = parameters.validate();
   if (!invalid.empty())
     throw ReconstructionError(invalid);
   if (parameters.use_normals && !has_normals)
     throw ReconstructionError("normals were requested but none were given");
+}
+
+/// `parameters` with one thread for a small cloud meshed in one piece
+/// (Parameters::min_points_for_threads); `points` counts the cloud's points.
+Parameters withThreadsWorthStarting(const Parameters &parameters, std::size_t points) {
+  Parameters adjusted = parameters;
+  if (points < parameters.min_points_for_threads && !usesBuckets(points, parameters))
+    adjusted.num_threads = 1;
+  return adjusted;
 }
 
 } // namespace
@@ -416,7 +425,8 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
   const Deadline deadline(parameters.time_limit_seconds);
   Result result;
   Clock::time_point stage = Clock::now();
-  const PreparedPoints prepared = detail::withThreads(parameters.num_threads, [&] {
+  const int preparing_threads = withThreadsWorthStarting(parameters, points.size).num_threads;
+  const PreparedPoints prepared = detail::withThreads(preparing_threads, [&] {
     return preparePoints(points, parameters.use_normals, !initial_triangles.empty(), result);
   });
   result.timings.prepare = secondsSince(stage);
@@ -429,8 +439,9 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
 /// Stages 2 to 4 on prepared points, into `result` (which has the
 /// preparation's figures).
 Result meshPrepared(const PreparedPoints &prepared, const std::vector<Triangle> &initial_triangles,
-                    const Parameters &parameters, BucketExchange &exchange,
-                    const Deadline &deadline, Clock::time_point start, Result result) {
+                    const Parameters &requested, BucketExchange &exchange, const Deadline &deadline,
+                    Clock::time_point start, Result result) {
+  const Parameters parameters = withThreadsWorthStarting(requested, prepared.positions.size());
   Clock::time_point stage;
   const bool preferred_mode = parameters.initial_triangles_mode == InitialTrianglesMode::preferred;
   const std::vector<Triangle> fixed = preferred_mode

@@ -87,7 +87,9 @@ void printReconstructHelp(const char *program, const char *summary) {
              "                  edge where sheets meet (default off: a 2-manifold mesh)\n");
   print_info("  -threads N      threads for the parallel stages, 0 = all cores (default ");
   print_value("%d", pcl_ms::Parameters().num_threads);
-  print_info(")\n");
+  print_info(");\n                  one thread for a cloud of under ");
+  print_value("%zu", pcl_ms::Parameters().min_points_for_threads);
+  print_info(" points in one piece\n");
   print_info("  -bucket_points M  mesh clouds larger than M points in buckets of about M points,\n"
              "                  stitched together; 0 = automatic: buckets of ");
   print_value("%zu", pcl_ms::default_bucket_points);

@@ -220,3 +220,24 @@ TEST(Threads, OneThreadReconstructionDoesNotStartTbb) {
   EXPECT_EQ(done.load(), 1000);
   EXPECT_TRUE(tbbAllocatorLoaded());
 }
+
+// A cloud meshed in one piece below Parameters::min_points_for_threads runs
+// on one thread whatever num_threads says: on 2 cores, TBB's start cost more
+// than the second thread saved below about 30,000 points.
+TEST(Threads, SmallCloudDoesNotStartTbb) {
+  if (tbbAllocatorLoaded())
+    GTEST_SKIP() << "TBB started earlier in this process (run the test alone)";
+  const std::vector<float> bunny = pcl_ms_test::bunnyCoordinates();
+  std::vector<float> xyz; // every 8th vertex: about 4,500 points
+  for (std::size_t i = 0; i + 3 <= bunny.size(); i += 3 * 8)
+    xyz.insert(xyz.end(), bunny.begin() + i, bunny.begin() + i + 3);
+  Parameters parameters;
+  parameters.num_threads = 2;
+  const Result small = reconstruct(pcl_ms_test::viewOf(xyz), parameters);
+  EXPECT_GT(small.triangles.size(), 7000u);
+  EXPECT_FALSE(tbbAllocatorLoaded());
+  parameters.min_points_for_threads = 0;
+  const Result threaded = reconstruct(pcl_ms_test::viewOf(xyz), parameters);
+  EXPECT_TRUE(tbbAllocatorLoaded());
+  EXPECT_EQ(threaded.triangles, small.triangles);
+}

@@ -21,6 +21,7 @@ inline int reconstructOneInput(const std::uint8_t *data, std::size_t size) {
   parameters.fill_holes_max_edges = (options & 1) ? 0 : 8;
   parameters.grid_buckets = (options & 2) ? 2 : 0; // buckets even for tiny clouds
   parameters.num_threads = (options & 4) ? 2 : 1;
+  parameters.min_points_for_threads = 0; // the parallel loops on tiny clouds too
   parameters.error_recovery = (options & 8) == 0;
   parameters.rho = 1.0 + (options >> 4);
   const std::vector<float> xyz = buildCloud(bytes);

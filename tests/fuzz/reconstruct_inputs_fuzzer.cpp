@@ -58,6 +58,7 @@ inline int reconstructInputsOneInput(const std::uint8_t *data, std::size_t size)
   const int initial_mode = (options >> 5) & 3; // 0: none, 1: fixed, 2 and 3: preferred
   parameters.grid_buckets = (options & 128) ? 2 : 0;
   parameters.num_threads = (more & 1) ? 2 : 1;
+  parameters.min_points_for_threads = 0; // the parallel loops on tiny clouds too
   parameters.fill_holes_max_edges = (more & 2) ? 0 : 8;
   constexpr double normal_weights[4] = {1.0, 0.0, 4.0, 0.5};
   parameters.normal_weight = normal_weights[(more >> 2) & 3];

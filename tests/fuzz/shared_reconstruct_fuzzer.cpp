@@ -27,6 +27,7 @@ inline int sharedReconstructOneInput(const std::uint8_t *data, std::size_t size)
   parameters.grid_buckets = (options & 4) ? 2 + ((options >> 3) & 1) : 0;
   parameters.fill_holes_max_edges = (options & 16) ? 0 : 8;
   parameters.num_threads = (options & 32) ? 2 : 1;
+  parameters.min_points_for_threads = 0; // the parallel loops on tiny clouds too
   std::vector<std::uint8_t> cut_bytes;
   for (int p = 1; p < processes; ++p)
     cut_bytes.push_back(bytes.byte());
