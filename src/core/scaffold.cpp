@@ -207,6 +207,10 @@ struct ChunkFacets {
   std::vector<double> shock_lengths; // one per acute or obtuse facet
 };
 
+/// Whether a facet of this kind was typed: its circle was found from its
+/// corners in ascending order, and its shock length measured.
+bool isTyped(FacetKind kind) { return kind == FacetKind::acute || kind == FacetKind::obtuse; }
+
 // |u x v|^2 above this times |u|^2 |v|^2 (a sine above 1e-10) cannot come
 // from rounding (about 1e-15 relative): those facets skip the exact test.
 constexpr double surely_not_collinear = 1e-20;
@@ -616,8 +620,7 @@ private:
       std::vector<double>::const_iterator next_shock_length = facets.shock_lengths.begin();
       for (std::size_t f = 0; f < fates.size(); ++f) {
         const FacetKind kind = facets.kinds[f];
-        const bool typed = kind == FacetKind::acute || kind == FacetKind::obtuse;
-        const double measured_shock_length = typed ? *next_shock_length++ : 0.0;
+        const double measured_shock_length = isTyped(kind) ? *next_shock_length++ : 0.0;
         if (fates[f] != FacetFate::gabriel && fates[f] != FacetFate::ambiguous)
           continue;
         prefetchCorners(facets, f + corner_prefetch_distance);
@@ -663,8 +666,8 @@ private:
       return FacetFate::oversize;
     if (kind == FacetKind::collinear || kind == FacetKind::circleless)
       return FacetFate::degenerate;
-    // The normal term needs the circle's normal.
-    if (options_.normals && !circumcircle(a, EdgeVectors(a, b, c)))
+    // The normal term needs the circle's normal (a typed facet's was found).
+    if (options_.normals && !isTyped(kind) && !circumcircle(a, EdgeVectors(a, b, c)))
       return FacetFate::degenerate;
     return kind == FacetKind::other ? FacetFate::ambiguous : FacetFate::gabriel;
   }
@@ -678,7 +681,7 @@ private:
     const double local_scale = triangleScale(scaffold_.local_scale, corners);
     const TriangleShape shape = triangleShape(a, b, c);
     double shock_length;
-    if (kind == FacetKind::acute || kind == FacetKind::obtuse) {
+    if (isTyped(kind)) {
       candidate.type = kind == FacetKind::acute ? CandidateType::acute : CandidateType::obtuse;
       shock_length = measured_shock_length;
     } else if (kind == FacetKind::gabriel_planar) {
