@@ -425,7 +425,8 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
   const Deadline deadline(parameters.time_limit_seconds);
   Result result;
   Clock::time_point stage = Clock::now();
-  const int preparing_threads = withThreadsWorthStarting(parameters, points.size).num_threads;
+  const std::size_t selected = points.indices ? points.indices.size() : points.size;
+  const int preparing_threads = withThreadsWorthStarting(parameters, selected).num_threads;
   const PreparedPoints prepared = detail::withThreads(preparing_threads, [&] {
     return preparePoints(points, parameters.use_normals, !initial_triangles.empty(), result);
   });
