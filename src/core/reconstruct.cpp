@@ -333,13 +333,13 @@ void checkParameters(const Parameters &parameters, bool has_normals) {
     throw ReconstructionError("normals were requested but none were given");
 }
 
-/// `parameters` with one thread for a small cloud meshed in one piece
-/// (Parameters::min_points_for_threads); `points` counts the cloud's points.
-Parameters withThreadsWorthStarting(const Parameters &parameters, std::size_t points) {
-  Parameters adjusted = parameters;
+/// Parameters::num_threads, or one thread for a small cloud meshed in one
+/// piece (Parameters::min_points_for_threads); `points` counts the cloud's
+/// points.
+int threadsWorthStarting(const Parameters &parameters, std::size_t points) {
   if (points < parameters.min_points_for_threads && !usesBuckets(points, parameters))
-    adjusted.num_threads = 1;
-  return adjusted;
+    return 1;
+  return parameters.num_threads;
 }
 
 } // namespace
@@ -426,7 +426,7 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
   Result result;
   Clock::time_point stage = Clock::now();
   const std::size_t selected = points.indices ? points.indices.size() : points.size;
-  const int preparing_threads = withThreadsWorthStarting(parameters, selected).num_threads;
+  const int preparing_threads = threadsWorthStarting(parameters, selected);
   const PreparedPoints prepared = detail::withThreads(preparing_threads, [&] {
     return preparePoints(points, parameters.use_normals, !initial_triangles.empty(), result);
   });
@@ -442,7 +442,8 @@ Result reconstructShared(const PointView &points, const Parameters &parameters,
 Result meshPrepared(const PreparedPoints &prepared, const std::vector<Triangle> &initial_triangles,
                     const Parameters &requested, BucketExchange &exchange, const Deadline &deadline,
                     Clock::time_point start, Result result) {
-  const Parameters parameters = withThreadsWorthStarting(requested, prepared.positions.size());
+  Parameters parameters = requested;
+  parameters.num_threads = threadsWorthStarting(requested, prepared.positions.size());
   Clock::time_point stage;
   const bool preferred_mode = parameters.initial_triangles_mode == InitialTrianglesMode::preferred;
   const std::vector<Triangle> fixed = preferred_mode

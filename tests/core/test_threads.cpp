@@ -241,3 +241,22 @@ TEST(Threads, SmallCloudDoesNotStartTbb) {
   EXPECT_TRUE(tbbAllocatorLoaded());
   EXPECT_EQ(threaded.triangles, small.triangles);
 }
+
+// The preparation counts the points the indices select, not the whole
+// cloud: 4,500 of the bunny's 35,947 vertices are a small cloud too.
+TEST(Threads, FewIndexedPointsDoNotStartTbb) {
+  if (tbbAllocatorLoaded())
+    GTEST_SKIP() << "TBB started earlier in this process (run the test alone)";
+  const std::vector<float> xyz = pcl_ms_test::bunnyCoordinates();
+  ASSERT_GE(xyz.size() / 3, Parameters().min_points_for_threads);
+  std::vector<std::int32_t> every_eighth;
+  for (std::size_t i = 0; i < xyz.size() / 3; i += 8)
+    every_eighth.push_back(static_cast<std::int32_t>(i));
+  PointView view = pcl_ms_test::viewOf(xyz);
+  view.indices = IndexList(every_eighth);
+  Parameters parameters;
+  parameters.num_threads = 2;
+  const Result small = reconstruct(view, parameters);
+  EXPECT_GT(small.triangles.size(), 7000u);
+  EXPECT_FALSE(tbbAllocatorLoaded());
+}
