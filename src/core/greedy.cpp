@@ -4,6 +4,7 @@
 // accepted cheapest first, with the passes' statistics. Here the passes; the
 // repairs after them in greedy_repair.cpp, opt-in seams in greedy_seams.cpp.
 #include "greedy_impl.h"
+#include "populate_pages.h"
 
 #include <pcl_ms/costs.h>
 
@@ -33,9 +34,10 @@ GreedyMesher::Impl::Impl(MedialScaffold &&scaffold, const std::vector<Eigen::Vec
                          GreedyStatistics &statistics)
     : graph_(std::move(scaffold)), scaffold_(graph_.scaffold()), candidates_(graph_.candidates()),
       points_(points), parameters_(parameters), deadline_(deadline), statistics_(statistics),
-      mesh_(scaffold_, points.size()), states_(candidates_.size()),
-      is_fixed_(candidates_.size(), false), is_preferred_(candidates_.size(), false),
-      multi_fan_vertex_(points.size(), false), may_have_several_fans_(points.size(), false) {
+      mesh_(scaffold_, points.size()), is_fixed_(candidates_.size(), false),
+      is_preferred_(candidates_.size(), false), multi_fan_vertex_(points.size(), false),
+      may_have_several_fans_(points.size(), false) {
+  detail::resizeForWriting(states_, candidates_.size());
   for (CandidateIndex t : scaffold_.fixed)
     is_fixed_[t] = true;
   for (CandidateIndex t : scaffold_.preferred)

@@ -9,6 +9,7 @@
 
 #include "flat_cells.h"
 #include "indexed_delaunay.h"
+#include "populate_pages.h"
 #include "threads.h"
 
 #include <algorithm>
@@ -431,8 +432,10 @@ private:
       return;
     }
     std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-    std::vector<float> radii_at(offsets[n]);
-    std::vector<VertexIndex> corners_at(2 * std::size_t{offsets[n]});
+    std::vector<float> radii_at;
+    std::vector<VertexIndex> corners_at;
+    detail::resizeForWriting(radii_at, offsets[n]);
+    detail::resizeForWriting(corners_at, 2 * std::size_t{offsets[n]});
     {
       std::vector<std::uint32_t> cursor(offsets.begin(), offsets.end() - 1);
       for (auto &gabriel : chunk_triangles) {
@@ -610,7 +613,7 @@ private:
       scaffold_.degenerate += chunks[chunk].counts[static_cast<int>(FacetFate::degenerate)];
     }
     std::vector<Candidate> &candidates = scaffold_.candidates;
-    candidates.resize(gabriel_total + ambiguous_total);
+    detail::resizeForWriting(candidates, gabriel_total + ambiguous_total);
     std::vector<std::array<std::size_t, 4>> type_counts(chunks.size(), {0, 0, 0, 0});
     forEachFacetChunk([&](std::size_t chunk) {
       const ChunkFacets &facets = chunk_facets_[chunk];

@@ -1,0 +1,40 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Fresh pages faulted in, in one call, before a large array is written in
+// full (docs/algorithm.md, "Memory pages"). Internal: not installed.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+namespace pcl_ms {
+namespace detail {
+
+/// Below this many bytes nothing is asked of the kernel: a small array's
+/// pages are few, and often reused heap pages already.
+inline constexpr std::size_t min_populated_bytes = std::size_t(64) << 10;
+
+/// Has the kernel fault in, writable, every whole page of [data, data +
+/// bytes) in one call (Linux 5.14's MADV_POPULATE_WRITE) instead of one
+/// fault per page at the first write. Only for memory the caller is about to
+/// write in full. The contents stay as they were. Nothing happens on other
+/// systems, on older kernels or when it fails: it only changes how fast the
+/// first writes go.
+void populateForWriting(const void *data, std::size_t bytes) noexcept;
+
+/// populateForWriting() of a vector's whole capacity.
+template <typename T, typename Allocator>
+void populateCapacity(const std::vector<T, Allocator> &values) noexcept {
+  populateForWriting(values.data(), values.capacity() * sizeof(T));
+}
+
+/// values.resize(size) on pages faulted in beforehand, for a vector whose
+/// every element the caller is about to write.
+template <typename T, typename Allocator>
+void resizeForWriting(std::vector<T, Allocator> &values, std::size_t size) {
+  values.reserve(size);
+  populateCapacity(values);
+  values.resize(size);
+}
+
+} // namespace detail
+} // namespace pcl_ms
