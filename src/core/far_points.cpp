@@ -2,6 +2,7 @@
 // Stray points (docs/algorithm.md section 1). In: distinct points. Out: the
 // points far from the rest, and a centre they cannot move.
 #include "far_points.h"
+#include "populate_pages.h"
 #include "threads.h"
 
 #include <algorithm>
@@ -84,7 +85,7 @@ FarPoints findFarPoints(const std::vector<Eigen::Vector3f> &points) {
     return selectedValue(values[axis][rank]);
   };
   parallelFor(0, 3, [&](std::size_t axis) {
-    values[axis].resize(n);
+    resizeForWriting(values[axis], n);
     for (std::size_t i = 0; i < n; ++i)
       values[axis][i] = points[i][axis];
     median_of_all[axis] = select(axis, 0, middle, n);

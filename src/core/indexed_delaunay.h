@@ -7,6 +7,7 @@
 #include <pcl_ms/types.h>
 
 #include "huge_page_allocator.h"
+#include "populate_pages.h"
 
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Delaunay_triangulation_cell_base_3.h>
@@ -46,6 +47,7 @@ std::vector<IndexedPoint> indexedPoints(const std::vector<Eigen::Vector3d> &poin
                                         const Indices &chosen) {
   std::vector<IndexedPoint> input;
   input.reserve(static_cast<std::size_t>(std::distance(std::begin(chosen), std::end(chosen))));
+  populateCapacity(input);
   for (VertexIndex i : chosen)
     input.emplace_back(KernelPoint(points[i].x(), points[i].y(), points[i].z()), i);
   return input;

@@ -11,7 +11,7 @@ namespace detail {
 
 /// Below this many bytes nothing is asked of the kernel: a small array's
 /// pages are few, and often reused heap pages already.
-inline constexpr std::size_t min_populated_bytes = std::size_t(64) << 10;
+inline constexpr std::size_t min_populated_bytes = std::size_t(16) << 10;
 
 /// Has the kernel fault in, writable, every whole page of [data, data +
 /// bytes) in one call (Linux 5.14's MADV_POPULATE_WRITE) instead of one
@@ -34,6 +34,16 @@ void resizeForWriting(std::vector<T, Allocator> &values, std::size_t size) {
   values.reserve(size);
   populateCapacity(values);
   values.resize(size);
+}
+
+/// A copy of `values` of exactly their size, on pages faulted in
+/// beforehand: to keep what was gathered in a list with room to spare.
+template <typename T> std::vector<T> exactCopy(const std::vector<T> &values) {
+  std::vector<T> copy;
+  copy.reserve(values.size());
+  populateCapacity(copy);
+  copy.assign(values.begin(), values.end());
+  return copy;
 }
 
 } // namespace detail

@@ -12,6 +12,7 @@
 
 #include "far_points.h"
 #include "point_keys.h"
+#include "populate_pages.h"
 #include "sort_unique.h"
 #include "threads.h"
 
@@ -133,6 +134,7 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
 
   std::vector<VertexIndex> records;
   records.reserve(count);
+  detail::populateCapacity(records);
   for (std::size_t i = 0; i < count; ++i) {
     std::size_t record = i;
     if (view.indices) {
@@ -153,7 +155,8 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
   // and centre, so that the rest of the cloud is meshed as without them.
   detail::FarPoints far;
   {
-    std::vector<Eigen::Vector3f> finite(records.size());
+    std::vector<Eigen::Vector3f> finite;
+    detail::resizeForWriting(finite, records.size());
     for (std::size_t i = 0; i < records.size(); ++i)
       finite[i] = Eigen::Vector3f(detail::recordAt(view.xyz, view.stride, records[i]));
     far = detail::findFarPoints(finite);
@@ -166,7 +169,8 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
         records[kept++] = records[i];
     records.resize(kept);
   }
-  std::vector<detail::PointKey> keys(records.size());
+  std::vector<detail::PointKey> keys;
+  detail::resizeForWriting(keys, records.size());
   {
     const detail::MortonCells cells(far.low, far.high);
     constexpr std::size_t grain = 1 << 14;
@@ -182,12 +186,17 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
   detail::parallelSort(keys.begin(), keys.end(), std::less<>()); // keys are distinct: one order
 
   PreparedPoints prepared;
-  if (map_records)
+  if (map_records) {
+    prepared.prepared_of_record.reserve(view.size);
+    detail::populateCapacity(prepared.prepared_of_record);
     prepared.prepared_of_record.assign(view.size, not_prepared);
+  }
   const Eigen::Vector3d &centre = far.median;
   prepared.centre = centre;
   prepared.positions.reserve(keys.size());
   prepared.user_index.reserve(keys.size());
+  detail::populateCapacity(prepared.positions);
+  detail::populateCapacity(prepared.user_index);
   if (with_normals)
     prepared.normals.reserve(keys.size());
   for (std::size_t i = 0; i < keys.size(); ++i) {
