@@ -134,7 +134,6 @@ PreparedPoints preparePoints(const PointView &view, bool with_normals, bool map_
 
   std::vector<VertexIndex> records;
   records.reserve(count);
-  detail::populateCapacity(records);
   for (std::size_t i = 0; i < count; ++i) {
     std::size_t record = i;
     if (view.indices) {

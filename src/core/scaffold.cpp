@@ -366,8 +366,8 @@ private:
         cells_.size(), options_.num_threads,
         [&](std::size_t chunk, std::size_t begin, std::size_t end) {
           // Filled with room for every facet the cells can own (4 a cell, 1
-          // in a plane), then kept at their exact sizes. Grown by doubling,
-          // the lists' copies were a quarter of the call's page faults
+          // in a plane), then kept at their exact sizes: grown by doubling,
+          // the lists' copies took a sixth of a call's page faults
           // (bench/README.md, "Pages faulted in before the first write").
           const std::size_t most_facets = (scaffold_.planar ? 1 : 4) * (end - begin);
           ChunkFacets facets;
