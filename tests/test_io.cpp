@@ -775,6 +775,12 @@ TEST_F(IoLoadMesh, BadIndicesAndShortFilesFail) {
   writeFile(path("nan_offset.vtk"), vtk_head + "POLYGONS 2 3\nOFFSETS vtktypeint64\n0 nan\n"
                                                "CONNECTIVITY vtktypeint64\n0 1 2\n");
   EXPECT_TRUE(contains(expectMeshFailure(path("nan_offset.vtk")), "offsets"));
+  // Faces checked against four points, then two points in a second list (a
+  // fuzzer's find): the faces would index points the mesh does not have.
+  writeFile(path("two_point_lists.vtk"),
+            vtk_head + "POLYGONS 1 4\n3 0 1 3\nPOINTS 2 float\n0 0 0 1 0 0\n");
+  EXPECT_TRUE(
+      contains(expectMeshFailure(path("two_point_lists.vtk")), "more than one POINTS section"));
 }
 
 TEST_F(IoLoadMesh, PointCloudFilesHaveNoFaces) {

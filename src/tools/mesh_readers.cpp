@@ -451,6 +451,12 @@ public:
       const std::vector<std::string_view> words = splitWords(line);
       const std::string_view key = words[0];
       if (key == "POINTS") {
+        // A dataset has one point list: a second one would leave the cells
+        // read so far indexing points it does not have.
+        if (have_points) {
+          error = "the VTK file has more than one POINTS section";
+          return false;
+        }
         if (!readPoints(words, vertices, error))
           return false;
         have_points = true;
