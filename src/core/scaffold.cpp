@@ -600,11 +600,13 @@ private:
   }
 
   /// The candidates, types I and II first (pass 1 of the greedy touches only
-  /// them, so its working set is a contiguous part of the list), each group
-  /// in the facets' order. Two steps over the facets: their fates, then the
-  /// costs of those that become candidates, each written once in its place.
-  /// A list per chunk copied into the whole one took longer: twice the fresh
-  /// memory, each page of it a fault (bench/README.md).
+  /// them, so its working set is a contiguous part of the list) in the
+  /// order of their corners (docs/algorithm.md, "Candidate order"), type III
+  /// after them in the facets' order. Two steps over the facets: their
+  /// fates, then the costs of those that become candidates, each written
+  /// once in its place. A list per chunk copied into the whole one took
+  /// longer: twice the fresh memory, each page of it a fault
+  /// (bench/README.md).
   void buildCandidates() {
     std::vector<ChunkFates> chunks(chunk_facets_.size());
     forEachFacetChunk([&](std::size_t chunk) {
@@ -618,11 +620,10 @@ private:
         ++out.counts[static_cast<int>(fate)];
       }
     });
-    // Where each chunk's candidates of either group start.
-    std::vector<std::size_t> gabriel_start(chunks.size()), ambiguous_start(chunks.size());
+    // Where each chunk's type III candidates start.
+    std::vector<std::size_t> ambiguous_start(chunks.size());
     std::size_t gabriel_total = 0, ambiguous_total = 0;
     for (std::size_t chunk = 0; chunk < chunks.size(); ++chunk) {
-      gabriel_start[chunk] = gabriel_total;
       ambiguous_start[chunk] = ambiguous_total;
       gabriel_total += chunks[chunk].counts[static_cast<int>(FacetFate::gabriel)];
       ambiguous_total += chunks[chunk].counts[static_cast<int>(FacetFate::ambiguous)];
@@ -631,11 +632,21 @@ private:
     }
     std::vector<Candidate> &candidates = scaffold_.candidates;
     detail::resizeForWriting(candidates, gabriel_total + ambiguous_total);
+    // Types I and II by lowest corner (a counting sort): next_gabriel[v]
+    // is where the next one whose lowest corner is v goes.
+    const std::size_t n = points_.size();
+    std::vector<std::uint32_t> next_gabriel(n + 1, 0);
+    for (std::size_t chunk = 0; chunk < chunks.size(); ++chunk) {
+      const std::vector<FacetFate> &fates = chunks[chunk].fates;
+      for (std::size_t f = 0; f < fates.size(); ++f)
+        if (fates[f] == FacetFate::gabriel)
+          ++next_gabriel[chunk_facets_[chunk].corners[f][0] + 1];
+    }
+    std::partial_sum(next_gabriel.begin(), next_gabriel.end(), next_gabriel.begin());
     std::vector<std::array<std::size_t, 4>> type_counts(chunks.size(), {0, 0, 0, 0});
     forEachFacetChunk([&](std::size_t chunk) {
       const ChunkFacets &facets = chunk_facets_[chunk];
       const std::vector<FacetFate> &fates = chunks[chunk].fates;
-      std::size_t next_gabriel = gabriel_start[chunk];
       std::size_t next_ambiguous = gabriel_total + ambiguous_start[chunk];
       std::vector<double>::const_iterator next_shock_length = facets.shock_lengths.begin();
       for (std::size_t f = 0; f < fates.size(); ++f) {
@@ -644,11 +655,26 @@ private:
         if (fates[f] != FacetFate::gabriel && fates[f] != FacetFate::ambiguous)
           continue;
         prefetchCorners(facets, f + corner_prefetch_distance);
+        // Chunks on other threads may share a lowest corner: the slot is
+        // taken atomically, and the order it gives is undone by the sort
+        // below.
         Candidate &candidate =
-            candidates[fates[f] == FacetFate::gabriel ? next_gabriel++ : next_ambiguous++];
+            candidates[fates[f] == FacetFate::gabriel
+                           ? __atomic_fetch_add(&next_gabriel[facets.corners[f][0]], 1u,
+                                                __ATOMIC_RELAXED)
+                           : next_ambiguous++];
         cost(facets.corners[f], kind, measured_shock_length, candidate);
         ++type_counts[chunk][static_cast<int>(candidate.type)];
       }
+    });
+    // Now next_gabriel[v] is where lowest corner v's candidates end, and the
+    // next smaller corner's end is where they begin: the few of each corner
+    // are sorted by their other two.
+    forEachChunk(n, options_.num_threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+      for (std::size_t v = begin; v < end; ++v)
+        std::sort(candidates.begin() + (v > 0 ? next_gabriel[v - 1] : 0),
+                  candidates.begin() + next_gabriel[v],
+                  [](const Candidate &a, const Candidate &b) { return a.vertices < b.vertices; });
     });
     for (const auto &counts : type_counts) {
       scaffold_.type1 += counts[1];

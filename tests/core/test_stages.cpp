@@ -220,6 +220,34 @@ TEST(Scaffold, EdgeGraphHoldsOnlyTheCandidatesOfPassOne) {
     ASSERT_LE(uses, 2) << edge.first << "-" << edge.second;
 }
 
+// Types I and II come first, in the order of their corners (what keeps
+// neighbours on the surface close in memory), type III after them; the
+// list is the same for any thread count, though the slots are taken by
+// several threads at once.
+TEST(Scaffold, GabrielCandidatesComeFirstInTheirCornersOrderOnAnyThreadCount) {
+  const std::vector<Eigen::Vector3d> points = pcl_ms_test::bunnyReference().vertices;
+  ScaffoldOptions one_thread, two_threads;
+  two_threads.num_threads = 2;
+  const MedialScaffold scaffold = buildMedialScaffold(points, one_thread);
+  const std::vector<Candidate> &candidates = scaffold.candidates;
+  const std::size_t gabriel = scaffold.type1 + scaffold.type2;
+  ASSERT_GT(gabriel, 10000u);
+  ASSERT_GT(scaffold.type3, 0u);
+  ASSERT_EQ(candidates.size(), gabriel + scaffold.type3);
+  for (std::size_t t = 0; t < candidates.size(); ++t)
+    ASSERT_EQ(candidates[t].type == CandidateType::ambiguous, t >= gabriel) << t;
+  for (std::size_t t = 1; t < gabriel; ++t)
+    ASSERT_LT(candidates[t - 1].vertices, candidates[t].vertices) << t;
+
+  const MedialScaffold again = buildMedialScaffold(points, two_threads);
+  ASSERT_EQ(again.candidates.size(), candidates.size());
+  for (std::size_t t = 0; t < candidates.size(); ++t) {
+    ASSERT_EQ(again.candidates[t].vertices, candidates[t].vertices) << t;
+    ASSERT_EQ(again.candidates[t].base_cost, candidates[t].base_cost) << t;
+    ASSERT_EQ(again.candidates[t].edges, candidates[t].edges) << t;
+  }
+}
+
 TEST(Scaffold, ObtuseGabrielTriangleIsTypeTwo) {
   const std::vector<Eigen::Vector3d> points = {{0, 0, 0}, {1, 0, 0}, {0.5, 0.2, 0}, {0.5, 0.1, 5}};
   const MedialScaffold scaffold = buildMedialScaffold(points, {});
