@@ -24,11 +24,6 @@ struct EdgeUse {
   }
 };
 
-/// Adds one to a count that other threads may add to as well.
-template <typename Count> Count countUp(Count &count) {
-  return __atomic_fetch_add(&count, Count{1}, __ATOMIC_RELAXED);
-}
-
 /// Replaces the boundary edges of `edges` by those that `leaves(e)` keeps,
 /// with `opened` (key, triangle; sorted) merged in, in key order; every
 /// triangle number passes through `number`.

@@ -608,6 +608,11 @@ private:
   /// longer: twice the fresh memory, each page of it a fault
   /// (bench/README.md).
   void buildCandidates() {
+    // Types I and II go by lowest corner (a counting sort): next_gabriel[v]
+    // counts those whose lowest corner is v - 1, then, summed, is where the
+    // next one whose lowest corner is v goes.
+    const std::size_t n = points_.size();
+    std::vector<std::uint32_t> next_gabriel(n + 1, 0);
     std::vector<ChunkFates> chunks(chunk_facets_.size());
     forEachFacetChunk([&](std::size_t chunk) {
       const ChunkFacets &facets = chunk_facets_[chunk];
@@ -618,6 +623,8 @@ private:
         const FacetFate fate = fateOf(facets.corners[f], facets.kinds[f]);
         out.fates[f] = fate;
         ++out.counts[static_cast<int>(fate)];
+        if (fate == FacetFate::gabriel)
+          detail::countUp(next_gabriel[facets.corners[f][0] + 1]);
       }
     });
     // Where each chunk's type III candidates start.
@@ -632,16 +639,6 @@ private:
     }
     std::vector<Candidate> &candidates = scaffold_.candidates;
     detail::resizeForWriting(candidates, gabriel_total + ambiguous_total);
-    // Types I and II by lowest corner (a counting sort): next_gabriel[v]
-    // is where the next one whose lowest corner is v goes.
-    const std::size_t n = points_.size();
-    std::vector<std::uint32_t> next_gabriel(n + 1, 0);
-    for (std::size_t chunk = 0; chunk < chunks.size(); ++chunk) {
-      const std::vector<FacetFate> &fates = chunks[chunk].fates;
-      for (std::size_t f = 0; f < fates.size(); ++f)
-        if (fates[f] == FacetFate::gabriel)
-          ++next_gabriel[chunk_facets_[chunk].corners[f][0] + 1];
-    }
     std::partial_sum(next_gabriel.begin(), next_gabriel.end(), next_gabriel.begin());
     std::vector<std::array<std::size_t, 4>> type_counts(chunks.size(), {0, 0, 0, 0});
     forEachFacetChunk([&](std::size_t chunk) {
@@ -658,11 +655,9 @@ private:
         // Chunks on other threads may share a lowest corner: the slot is
         // taken atomically, and the order it gives is undone by the sort
         // below.
-        Candidate &candidate =
-            candidates[fates[f] == FacetFate::gabriel
-                           ? __atomic_fetch_add(&next_gabriel[facets.corners[f][0]], 1u,
-                                                __ATOMIC_RELAXED)
-                           : next_ambiguous++];
+        Candidate &candidate = candidates[fates[f] == FacetFate::gabriel
+                                              ? detail::countUp(next_gabriel[facets.corners[f][0]])
+                                              : next_ambiguous++];
         cost(facets.corners[f], kind, measured_shock_length, candidate);
         ++type_counts[chunk][static_cast<int>(candidate.type)];
       }
