@@ -17,6 +17,15 @@ namespace detail {
 namespace {
 // Linux's value, which older headers lack.
 constexpr int populate_write_advice = 23;
+constexpr std::uintptr_t huge_page = std::uintptr_t(2) << 20;
+
+/// The whole pages of size `page` inside [start, start + bytes), advised.
+void advise(std::uintptr_t start, std::size_t bytes, std::uintptr_t page, int advice) noexcept {
+  const std::uintptr_t first = (start + page - 1) & ~(page - 1);
+  const std::uintptr_t last = (start + bytes) & ~(page - 1);
+  if (last > first)
+    madvise(reinterpret_cast<void *>(first), last - first, advice);
+}
 } // namespace
 
 void populateForWriting(const void *data, std::size_t bytes) noexcept {
@@ -24,10 +33,10 @@ void populateForWriting(const void *data, std::size_t bytes) noexcept {
     return;
   static const std::uintptr_t page = static_cast<std::uintptr_t>(sysconf(_SC_PAGESIZE));
   const auto start = reinterpret_cast<std::uintptr_t>(data);
-  const std::uintptr_t first = (start + page - 1) & ~(page - 1);
-  const std::uintptr_t last = (start + bytes) & ~(page - 1);
-  if (last > first)
-    madvise(reinterpret_cast<void *>(first), last - first, populate_write_advice);
+  // The whole huge pages inside go on huge pages, like the triangulation's
+  // store (huge_page_allocator.h): one fault each instead of 512.
+  advise(start, bytes, huge_page, MADV_HUGEPAGE);
+  advise(start, bytes, page, populate_write_advice);
 }
 
 #else

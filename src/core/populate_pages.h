@@ -15,10 +15,10 @@ inline constexpr std::size_t min_populated_bytes = std::size_t(16) << 10;
 
 /// Has the kernel fault in, writable, every whole page of [data, data +
 /// bytes) in one call (Linux 5.14's MADV_POPULATE_WRITE) instead of one
-/// fault per page at the first write. Only for memory the caller is about to
-/// write in full. The contents stay as they were. Nothing happens on other
-/// systems, on older kernels or when it fails: it only changes how fast the
-/// first writes go.
+/// fault per page at the first write, the whole 2 MB pages inside it on
+/// transparent huge pages where the kernel gives them on advice. Only for memory the caller is
+/// about to write in full. The contents stay as they were. Nothing happens on other systems, on
+/// older kernels or when it fails: it only changes how fast the first writes go.
 void populateForWriting(const void *data, std::size_t bytes) noexcept;
 
 /// populateForWriting() of a vector's whole capacity.

@@ -3,9 +3,11 @@
 // (src/core/huge_page_allocator.h).
 #include "core_test_support.h"
 #include "huge_page_allocator.h"
+#include "populate_pages.h"
 
 #include <pcl_ms/reconstruct.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -134,4 +136,16 @@ TEST(HugePages, ReconstructionLeavesNoRegionBehind) {
   const Result result = reconstruct(viewOf(xyz), Parameters());
   EXPECT_GT(result.triangles.size(), 39000u);
   EXPECT_EQ(detail::regionsMapped(), before);
+}
+
+// The large arrays written in full as soon as they exist (the candidates,
+// the greedy's states) get huge pages the same way.
+TEST(HugePages, ArraysResizedForWritingAreOnHugePagesWhereTheKernelMakesThem) {
+  if (!hugePagesMadeAtFault())
+    GTEST_SKIP() << "no transparent huge pages at fault here";
+  std::vector<std::uint64_t> values;
+  detail::resizeForWriting(values, std::size_t(1) << 20); // 8 MB: 3 whole huge pages at least
+  std::fill(values.begin(), values.end(), 5u);
+  EXPECT_GE(hugePagesKbAt(values.data() + values.size() / 2), 2048);
+  EXPECT_EQ(values.back(), 5u);
 }
