@@ -2,6 +2,7 @@
 // Huge-page regions for the large blocks of CGAL's triangulation containers
 // (huge_page_allocator.h; docs/algorithm.md, "Memory pages").
 #include "huge_page_allocator.h"
+#include "populate_pages.h"
 
 #include <atomic>
 #include <cstdint>
@@ -18,11 +19,10 @@ std::atomic<std::size_t> regions_mapped{0};
 
 #if PCL_MS_HUGE_PAGE_REGIONS
 
-constexpr std::size_t huge_page = std::size_t(2) << 20;
 // A region's size: sixteen huge pages. A 2,000-point cloud's triangulation
 // (all its blocks below huge_page_block_bytes) maps none, 300,000 points'
 // cells (about 150 MB) fill five.
-constexpr std::size_t region_bytes = 16 * huge_page;
+constexpr std::size_t region_bytes = 16 * huge_page_bytes;
 // Each block starts with the address of its region, padded to keep the
 // block's 64-byte alignment.
 constexpr std::size_t block_header = 64;
@@ -40,21 +40,21 @@ std::size_t roundUp(std::size_t value, std::size_t step) {
   return (value + step - 1) / step * step;
 }
 
-/// `bytes` (a multiple of huge_page) aligned to a huge page, advised onto
+/// `bytes` (a multiple of huge_page_bytes) aligned to a huge page, advised onto
 /// huge pages, with one reference.
 Region *mapRegion(std::size_t bytes) {
-  void *mapped =
-      mmap(nullptr, bytes + huge_page, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  void *mapped = mmap(nullptr, bytes + huge_page_bytes, PROT_READ | PROT_WRITE,
+                      MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
   if (mapped == MAP_FAILED)
     throw std::bad_alloc();
   // mmap aligns to 4 kB only: the slack before and after the aligned range
   // goes back at once.
   const auto start = reinterpret_cast<std::uintptr_t>(mapped);
-  const std::uintptr_t aligned = roundUp(start, huge_page);
+  const std::uintptr_t aligned = roundUp(start, huge_page_bytes);
   if (aligned > start)
     munmap(mapped, aligned - start);
-  if (aligned + bytes < start + bytes + huge_page)
-    munmap(reinterpret_cast<void *>(aligned + bytes), start + huge_page - aligned);
+  if (aligned + bytes < start + bytes + huge_page_bytes)
+    munmap(reinterpret_cast<void *>(aligned + bytes), start + huge_page_bytes - aligned);
   void *region_start = reinterpret_cast<void *>(aligned);
   // A hint: where the kernel has transparent huge pages off, the region is
   // ordinary memory.
@@ -103,7 +103,7 @@ void *allocateFromRegion(std::size_t bytes) {
   const std::size_t needed = roundUp(bytes, 64) + block_header;
   if (needed > region_bytes - block_header) {
     // A block larger than a region gets one of its own, unshared.
-    Region *own = mapRegion(roundUp(needed + block_header, huge_page));
+    Region *own = mapRegion(roundUp(needed + block_header, huge_page_bytes));
     return placeBlock(own, needed);
   }
   Region *region = current.region;

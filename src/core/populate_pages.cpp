@@ -17,7 +17,6 @@ namespace detail {
 namespace {
 // Linux's value, which older headers lack.
 constexpr int populate_write_advice = 23;
-constexpr std::uintptr_t huge_page = std::uintptr_t(2) << 20;
 
 /// The whole pages of size `page` inside [start, start + bytes), advised.
 void advise(std::uintptr_t start, std::size_t bytes, std::uintptr_t page, int advice) noexcept {
@@ -35,7 +34,7 @@ void populateForWriting(const void *data, std::size_t bytes) noexcept {
   const auto start = reinterpret_cast<std::uintptr_t>(data);
   // The whole huge pages inside go on huge pages, like the triangulation's
   // store (huge_page_allocator.h): one fault each instead of 512.
-  advise(start, bytes, huge_page, MADV_HUGEPAGE);
+  advise(start, bytes, huge_page_bytes, MADV_HUGEPAGE);
   advise(start, bytes, page, populate_write_advice);
 }
 

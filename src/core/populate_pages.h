@@ -13,12 +13,19 @@ namespace detail {
 /// pages are few, and often reused heap pages already.
 inline constexpr std::size_t min_populated_bytes = std::size_t(16) << 10;
 
+/// A transparent huge page where base pages are 4 kB (x86-64, most arm64
+/// kernels). Both the populated arrays and the triangulation's store
+/// (huge_page_allocator.h) work in whole pages of this size.
+inline constexpr std::size_t huge_page_bytes = std::size_t(2) << 20;
+
 /// Has the kernel fault in, writable, every whole page of [data, data +
 /// bytes) in one call (Linux 5.14's MADV_POPULATE_WRITE) instead of one
-/// fault per page at the first write, the whole 2 MB pages inside it on
-/// transparent huge pages where the kernel gives them on advice. Only for memory the caller is
-/// about to write in full. The contents stay as they were. Nothing happens on other systems, on
-/// older kernels or when it fails: it only changes how fast the first writes go.
+/// fault per page at the first write. The whole huge pages inside the range
+/// are advised onto transparent huge pages first, where the kernel gives
+/// them on advice. Only for memory the caller is about to write in full.
+/// The contents stay as they were. Nothing happens on other systems, on
+/// older kernels or when it fails: it only changes how fast the first
+/// writes go.
 void populateForWriting(const void *data, std::size_t bytes) noexcept;
 
 /// populateForWriting() of a vector's whole capacity.
