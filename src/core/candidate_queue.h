@@ -119,27 +119,54 @@ private:
 /// The queue of one pass. Most entries arrive together before the pass
 /// pops any (the pass's initial costs): those are sorted once and read in
 /// order, which costs far less than sifting each through a heap of millions
-/// of entries, the greedy's main cost at 300,000 points. Entries pushed while
-/// the pass runs (changed costs) go to a small heap. The heap has no
-/// handles: a candidate whose cost changes is pushed again and
-/// its outdated entry skipped when it surfaces (lazy deletion). Entries are
-/// totally ordered, so the pops come in the same order as from one heap.
+/// of entries, the greedy's main cost at 300,000 points. Entries pushed
+/// while the pass runs (changed costs) go to a small heap, except delayed
+/// candidates: their costs rise with the pass, so most of them extend a
+/// second sorted run (bench/README.md, "Delayed candidates in a run of
+/// their own"). The heap has no handles: a candidate whose cost changes is
+/// pushed again and its outdated entry skipped when it surfaces (lazy
+/// deletion). Entries are totally ordered, so the pops come in the same
+/// order as from one heap.
 class CandidateQueue {
 public:
   void push(const QueueEntry &entry) { arrived_.push_back(entry); }
+  /// push() of an entry likely to be no cheaper than the one pushed this way
+  /// before it: appended to the delayed run when it keeps the run sorted.
+  void pushDelayed(const QueueEntry &entry) {
+    if (delayed_next_ == delayed_.size() || !(entry < delayed_.back()))
+      delayed_.push_back(entry);
+    else
+      arrived_.push_back(entry);
+  }
   bool empty() const { return size() == 0; }
   const QueueEntry &top() {
     settleArrivals();
-    return sortedRunFirst() ? sorted_[next_] : heap_.top();
+    switch (cheapestSource()) {
+    case Source::sorted:
+      return sorted_[next_];
+    case Source::delayed:
+      return delayed_[delayed_next_];
+    default:
+      return heap_.top();
+    }
   }
   void pop() {
     settleArrivals();
-    if (sortedRunFirst())
+    switch (cheapestSource()) {
+    case Source::sorted:
       ++next_;
-    else
+      break;
+    case Source::delayed:
+      popDelayed();
+      break;
+    default:
       heap_.pop();
+    }
   }
-  std::size_t size() const { return sorted_.size() - next_ + heap_.size() + arrived_.size(); }
+  std::size_t size() const {
+    return sorted_.size() - next_ + delayed_.size() - delayed_next_ + heap_.size() +
+           arrived_.size();
+  }
   /// The candidate `steps` places further along the sorted run, if any: the
   /// pass fetches its data early, as the run visits candidates in no order
   /// of memory.
@@ -147,10 +174,16 @@ public:
     return next_ + steps < sorted_.size() ? &sorted_[next_ + steps] : nullptr;
   }
 
-  /// The heap's cheapest entry, if any, arrivals not counted: the pass
-  /// fetches its data while deciding the current candidate, as it may well
-  /// be the next one popped.
-  const QueueEntry *heapTop() const { return heap_.empty() ? nullptr : &heap_.top(); }
+  /// The cheapest entry pushed while the pass runs, if any, arrivals not
+  /// counted: the pass fetches its data while deciding the current
+  /// candidate, as it may well be the next one popped.
+  const QueueEntry *pushedTop() const {
+    const QueueEntry *delayed =
+        delayed_next_ < delayed_.size() ? &delayed_[delayed_next_] : nullptr;
+    if (heap_.empty())
+      return delayed;
+    return delayed && *delayed < heap_.top() ? delayed : &heap_.top();
+  }
 
   /// Drops the outdated entries.
   template <typename IsCurrent> void compact(const IsCurrent &is_current) {
@@ -160,6 +193,11 @@ public:
                  std::back_inserter(current), is_current);
     sorted_ = std::move(current);
     next_ = 0;
+    current.clear();
+    std::copy_if(delayed_.begin() + static_cast<std::ptrdiff_t>(delayed_next_), delayed_.end(),
+                 std::back_inserter(current), is_current);
+    delayed_ = std::move(current);
+    delayed_next_ = 0;
     std::vector<QueueEntry> in_heap;
     for (auto it = heap_.begin(); it != heap_.end(); ++it)
       if (is_current(*it))
@@ -175,8 +213,36 @@ private:
   // rather than pushed onto the heap one by one.
   static constexpr std::size_t min_sorted_batch = 1024;
 
-  bool sortedRunFirst() const {
-    return next_ < sorted_.size() && (heap_.empty() || !(heap_.top() < sorted_[next_]));
+  // Once this many entries of the delayed run are read, and they are at
+  // least half of it, they are dropped from its front.
+  static constexpr std::size_t min_delayed_read = 4096;
+
+  enum class Source { sorted, delayed, heap };
+
+  /// Where the cheapest entry is; the sorted run wins ties (equal keys are
+  /// the same entry).
+  Source cheapestSource() const {
+    Source source = Source::heap;
+    const QueueEntry *cheapest = heap_.empty() ? nullptr : &heap_.top();
+    if (delayed_next_ < delayed_.size() && (!cheapest || delayed_[delayed_next_] < *cheapest)) {
+      cheapest = &delayed_[delayed_next_];
+      source = Source::delayed;
+    }
+    if (next_ < sorted_.size() && (!cheapest || !(*cheapest < sorted_[next_])))
+      source = Source::sorted;
+    return source;
+  }
+
+  void popDelayed() {
+    ++delayed_next_;
+    if (delayed_next_ == delayed_.size()) {
+      delayed_.clear();
+      delayed_next_ = 0;
+    } else if (delayed_next_ >= min_delayed_read && 2 * delayed_next_ >= delayed_.size()) {
+      delayed_.erase(delayed_.begin(),
+                     delayed_.begin() + static_cast<std::ptrdiff_t>(delayed_next_));
+      delayed_next_ = 0;
+    }
   }
 
   void settleArrivals() {
@@ -211,6 +277,8 @@ private:
   std::vector<QueueEntry> arrived_; // pushed, not yet placed
   std::vector<QueueEntry> sorted_;  // ascending from next_
   std::size_t next_ = 0;
+  std::vector<QueueEntry> delayed_; // ascending from delayed_next_
+  std::size_t delayed_next_ = 0;
   EntryHeap heap_;
 };
 

@@ -230,21 +230,24 @@ void GreedyMesher::Impl::refreshCost(CandidateIndex t) {
     enqueue(t, states_[t].state);
 }
 
-/// Puts t's current cost on the heap of `queue` (its state already).
-void GreedyMesher::Impl::enqueue(CandidateIndex t, State queue) {
+/// Puts t's current cost in the queue of `queue` (its state already).
+void GreedyMesher::Impl::enqueue(CandidateIndex t, State queue, Arrival arrival) {
   CandidateQueue &heap = queues_[queueNumber(queue)];
   states_[t].queued_cost = states_[t].cost;
-  heap.push(QueueEntry(states_[t].cost, t));
+  if (arrival == Arrival::delayed)
+    heap.pushDelayed(QueueEntry(states_[t].cost, t));
+  else
+    heap.push(QueueEntry(states_[t].cost, t));
   if (heap.size() > 2 * queued_[queueNumber(queue)] + compaction_slack)
     heap.compact([&](const QueueEntry &entry) { return isLive(entry, queue); });
 }
 
-void GreedyMesher::Impl::push(CandidateIndex t, State queue) {
+void GreedyMesher::Impl::push(CandidateIndex t, State queue, Arrival arrival) {
   states_[t].state = queue;
   if (queue == State::queue2 && !queue2_built_)
     return; // queued when pass 2 starts
   ++queued_[queueNumber(queue)];
-  enqueue(t, queue);
+  enqueue(t, queue, arrival);
 }
 
 /// Q2 waits through pass 1 untouched (most of it is type III far from the
@@ -283,7 +286,7 @@ void GreedyMesher::Impl::runPass(State queue_state, PassStatistics &statistics) 
       __builtin_prefetch(&states_[ahead->candidate()]);
       __builtin_prefetch(&candidates_[ahead->candidate()]);
     }
-    if (const QueueEntry *next = queue.heapTop()) {
+    if (const QueueEntry *next = queue.pushedTop()) {
       __builtin_prefetch(&states_[next->candidate()]);
       __builtin_prefetch(&candidates_[next->candidate()]);
     }
@@ -300,7 +303,7 @@ void GreedyMesher::Impl::runPass(State queue_state, PassStatistics &statistics) 
     states_[t].state = State::idle;
     ++statistics.popped;
     decide(t, queue_state, statistics);
-    if (const QueueEntry *next = queue.heapTop()) {
+    if (const QueueEntry *next = queue.pushedTop()) {
       mesh_.prefetchAround(next->candidate());
       graph_.prefetchListStarts(next->candidate());
     }
@@ -369,7 +372,7 @@ void GreedyMesher::Impl::decide(CandidateIndex t, State from, PassStatistics &st
 
 void GreedyMesher::Impl::delay(CandidateIndex t, State from, PassStatistics &statistics) {
   states_[t].cost = static_cast<float>(freshCost(t));
-  push(t, from);
+  push(t, from, Arrival::delayed);
   ++statistics.delayed;
 }
 

@@ -116,8 +116,11 @@ private:
     return state.state == queue && state.queued_cost == entry.cost();
   }
 
-  void enqueue(CandidateIndex t, State queue);
-  void push(CandidateIndex t, State queue);
+  /// How a candidate comes to be queued: a delayed one's cost rises with
+  /// the pass (CandidateQueue::pushDelayed).
+  enum class Arrival { ordinary, delayed };
+  void enqueue(CandidateIndex t, State queue, Arrival arrival = Arrival::ordinary);
+  void push(CandidateIndex t, State queue, Arrival arrival = Arrival::ordinary);
   void buildQueue2(PassStatistics &statistics);
 
   // ---- the candidate graph (candidate_graph.h) -----------------------------

@@ -1,14 +1,16 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The greedy's queue (candidate_queue.h): whatever way entries arrive (a
 // large batch sorted into the run, with or without a rest of the run to
-// merge with, or a few pushed onto the heap), they come out cheapest first,
-// ties by candidate index, none lost and none repeated.
+// merge with, a few pushed onto the heap, or delayed ones into their own
+// run), they come out cheapest first, ties by candidate index, none lost and
+// none repeated.
 #include "candidate_queue.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <random>
+#include <set>
 #include <vector>
 
 namespace {
@@ -72,4 +74,58 @@ TEST(CandidateQueue, EntriesComeOutCheapestFirstThroughEveryPath) {
   EXPECT_TRUE(queue.empty());
   EXPECT_EQ(popped, 14050u);
   EXPECT_EQ(queue.size(), 0u);
+}
+
+// A pass as the greedy runs it: each popped candidate may come back delayed
+// at a higher cost (mostly rising, so most extend the delayed run; some lower
+// than the run's last, so they take the ordinary path), while changed costs
+// arrive as ordinary pushes and compaction drops outdated entries.
+TEST(CandidateQueue, DelayedEntriesComeOutInOrderWithTheRest) {
+  std::mt19937 random(20261206);
+  CandidateQueue queue;
+  std::multiset<Pushed> waiting; // the reference
+  pcl_ms::CandidateIndex next_candidate = 0;
+  auto push = [&](float cost, bool delayed) {
+    const Pushed entry{cost, next_candidate++};
+    waiting.insert(entry);
+    if (delayed)
+      queue.pushDelayed(QueueEntry(entry.cost, entry.candidate));
+    else
+      queue.push(QueueEntry(entry.cost, entry.candidate));
+  };
+  for (int i = 0; i < 20000; ++i)
+    push(randomCost(random), false);
+  std::uniform_int_distribution<int> dice(0, 99);
+  std::size_t popped = 0, compactions = 0;
+  while (!waiting.empty()) {
+    ASSERT_FALSE(queue.empty());
+    const Pushed cheapest = *waiting.begin();
+    const QueueEntry top = queue.top();
+    ASSERT_EQ(top.cost(), cheapest.cost) << "pop " << popped;
+    ASSERT_EQ(top.candidate(), cheapest.candidate) << "pop " << popped;
+    queue.pop();
+    waiting.erase(waiting.begin());
+    ++popped;
+    if (next_candidate >= 60000)
+      continue; // drain
+    const int roll = dice(random);
+    if (roll < 50)
+      push(cheapest.cost * 1.2f + 0.01f, true);
+    else if (roll < 55)
+      push(cheapest.cost * 0.5f, true); // below the delayed run's last entry
+    else if (roll < 75)
+      push(cheapest.cost + 0.25f * static_cast<float>(dice(random) % 4), false);
+    if (popped % 9000 == 0) {
+      auto isCurrent = [](const QueueEntry &entry) { return entry.candidate() % 7 != 3; };
+      queue.compact(isCurrent);
+      for (auto it = waiting.begin(); it != waiting.end();)
+        it = isCurrent(QueueEntry(it->cost, it->candidate)) ? std::next(it) : waiting.erase(it);
+      ++compactions;
+      ASSERT_EQ(queue.size(), waiting.size());
+    }
+  }
+  EXPECT_TRUE(queue.empty());
+  EXPECT_EQ(queue.size(), 0u);
+  EXPECT_GT(compactions, 3u);
+  EXPECT_GT(popped, 50000u);
 }
