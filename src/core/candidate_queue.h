@@ -222,15 +222,10 @@ private:
   /// Where the cheapest entry is; the sorted run wins ties (equal keys are
   /// the same entry).
   Source cheapestSource() const {
-    Source source = Source::heap;
-    const QueueEntry *cheapest = heap_.empty() ? nullptr : &heap_.top();
-    if (delayed_next_ < delayed_.size() && (!cheapest || delayed_[delayed_next_] < *cheapest)) {
-      cheapest = &delayed_[delayed_next_];
-      source = Source::delayed;
-    }
-    if (next_ < sorted_.size() && (!cheapest || !(*cheapest < sorted_[next_])))
-      source = Source::sorted;
-    return source;
+    const QueueEntry *pushed = pushedTop();
+    if (next_ < sorted_.size() && (!pushed || !(*pushed < sorted_[next_])))
+      return Source::sorted;
+    return !heap_.empty() && pushed == &heap_.top() ? Source::heap : Source::delayed;
   }
 
   void popDelayed() {
