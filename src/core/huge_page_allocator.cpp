@@ -4,11 +4,15 @@
 #include "huge_page_allocator.h"
 #include "populate_pages.h"
 
+#include <algorithm>
+#include <array>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 
 #if PCL_MS_HUGE_PAGE_REGIONS
 #include <sys/mman.h>
+#include <unistd.h>
 #endif
 
 namespace pcl_ms {
@@ -26,6 +30,38 @@ constexpr std::size_t region_bytes = 16 * huge_page_bytes;
 // Each block starts with the address of its region, padded to keep the
 // block's 64-byte alignment.
 constexpr std::size_t block_header = 64;
+
+// Regions pay where a first write to a fresh 4 kB page costs more than
+// this: about 15 µs on the machines where huge pages made the triangulation
+// faster, about 1 µs on one where they made it slower (bench/README.md, "The
+// triangulation's store on huge pages where faults are slow").
+constexpr double slow_first_write_seconds = 5e-6;
+// Pages the probe writes: its median ignores a few preempted writes.
+constexpr std::size_t probe_pages = 64;
+
+/// The median time of a first write to a fresh 4 kB page; 0 where no memory
+/// could be mapped.
+double medianFirstWriteSeconds() {
+  const auto page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+  void *mapped =
+      mmap(nullptr, probe_pages * page, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (mapped == MAP_FAILED)
+    return 0;
+  madvise(mapped, probe_pages * page, MADV_NOHUGEPAGE);
+  volatile char *bytes = static_cast<volatile char *>(mapped);
+  std::array<double, probe_pages> seconds{};
+  for (std::size_t i = 0; i < probe_pages; ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    bytes[i * page] = 1;
+    seconds[i] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  munmap(mapped, probe_pages * page);
+  std::nth_element(seconds.begin(), seconds.begin() + probe_pages / 2, seconds.end());
+  return seconds[probe_pages / 2];
+}
+
+// -1 until chosen, then 1 for regions, 0 for the heap.
+std::atomic<int> regions_chosen{-1};
 
 /// Sits at the start of its region. `references` counts the live blocks,
 /// plus one while the region is its thread's current one; `used` is moved
@@ -96,10 +132,33 @@ void *placeBlock(Region *region, std::size_t bytes) {
 
 #if PCL_MS_HUGE_PAGE_REGIONS
 
+bool regionsInUse() {
+  int chosen = regions_chosen.load(std::memory_order_acquire);
+  if (chosen < 0) {
+    // Threads that get here together may each measure; the first choice stored stays.
+    int undecided = -1;
+    regions_chosen.compare_exchange_strong(
+        undecided, medianFirstWriteSeconds() > slow_first_write_seconds ? 1 : 0,
+        std::memory_order_acq_rel);
+    chosen = regions_chosen.load(std::memory_order_acquire);
+  }
+  return chosen == 1;
+}
+
+void useRegions(bool on) { regions_chosen.store(on ? 1 : 0, std::memory_order_release); }
+
 void *allocateFromRegion(std::size_t bytes) {
   // More than the address space holds; rounding it up below would wrap.
   if (bytes > std::size_t(-1) / 4)
     throw std::bad_alloc();
+  if (!regionsInUse()) {
+    // From the heap, with a header that names no region, so that the block
+    // goes back to the heap whatever is chosen by then.
+    auto *base =
+        static_cast<char *>(::operator new (bytes + block_header, std::align_val_t{block_header}));
+    *reinterpret_cast<Region **>(base) = nullptr;
+    return base + block_header;
+  }
   const std::size_t needed = roundUp(bytes, 64) + block_header;
   if (needed > region_bytes - block_header) {
     // A block larger than a region gets one of its own, unshared.
@@ -119,7 +178,12 @@ void *allocateFromRegion(std::size_t bytes) {
 }
 
 void deallocateToRegion(void *block) noexcept {
-  Region *region = *reinterpret_cast<Region **>(static_cast<char *>(block) - block_header);
+  char *base = static_cast<char *>(block) - block_header;
+  Region *region = *reinterpret_cast<Region **>(base);
+  if (!region) {
+    ::operator delete (base, std::align_val_t{block_header});
+    return;
+  }
   // The thread's last block in its current region: the region goes with it,
   // so that a finished triangulation leaves no memory behind (a reference
   // alone would keep its touched pages until the thread allocates again).
@@ -131,6 +195,10 @@ void deallocateToRegion(void *block) noexcept {
 }
 
 #else
+
+bool regionsInUse() { return false; }
+
+void useRegions(bool) {}
 
 void *allocateFromRegion(std::size_t bytes) { return ::operator new(bytes); }
 

@@ -59,11 +59,25 @@ long hugePagesKbAt(const void *address) {
   return -1;
 }
 
+/// Regions on or off while it lives, whatever the probe chose (each test
+/// sets what it checks; the machine's own choice comes back after it).
+class RegionsChosen {
+public:
+  explicit RegionsChosen(bool on) : before_(detail::regionsInUse()) { detail::useRegions(on); }
+  ~RegionsChosen() { detail::useRegions(before_); }
+  RegionsChosen(const RegionsChosen &) = delete;
+  RegionsChosen &operator=(const RegionsChosen &) = delete;
+
+private:
+  bool before_;
+};
+
 } // namespace
 
 TEST(HugePages, SmallBlocksComeFromTheHeapAndLargeOnesFromRegionsThatGoWithThem) {
   if (!PCL_MS_HUGE_PAGE_REGIONS)
     GTEST_SKIP() << "regions are off in this build (AddressSanitizer or not Linux)";
+  const RegionsChosen regions(true);
   const std::size_t before = detail::regionsMapped();
   HugePageAllocator<double> allocator;
   double *small = allocator.allocate(100);
@@ -95,6 +109,7 @@ TEST(HugePages, SmallBlocksComeFromTheHeapAndLargeOnesFromRegionsThatGoWithThem)
 TEST(HugePages, BlocksFreedOnAnotherThreadLeaveNoRegionWhenTheirThreadEnds) {
   if (!PCL_MS_HUGE_PAGE_REGIONS)
     GTEST_SKIP() << "regions are off in this build (AddressSanitizer or not Linux)";
+  const RegionsChosen regions(true);
   const std::size_t before = detail::regionsMapped();
   const std::size_t count = (std::size_t(1) << 18) / sizeof(int);
   std::vector<int *> blocks(8, nullptr);
@@ -122,6 +137,7 @@ TEST(HugePages, BlocksFreedOnAnotherThreadLeaveNoRegionWhenTheirThreadEnds) {
 TEST(HugePages, LargeBlocksAreOnHugePagesWhereTheKernelMakesThem) {
   if (!PCL_MS_HUGE_PAGE_REGIONS || !hugePagesMadeAtFault())
     GTEST_SKIP() << "no transparent huge pages at fault here";
+  const RegionsChosen regions(true);
   HugePageAllocator<char> allocator;
   const std::size_t bytes = std::size_t(8) << 20;
   char *block = allocator.allocate(bytes);
@@ -131,10 +147,63 @@ TEST(HugePages, LargeBlocksAreOnHugePagesWhereTheKernelMakesThem) {
 }
 
 TEST(HugePages, ReconstructionLeavesNoRegionBehind) {
+  const RegionsChosen regions(true);
   const std::size_t before = detail::regionsMapped();
   const std::vector<float> xyz = fibonacciSphere(20000);
   const Result result = reconstruct(viewOf(xyz), Parameters());
   EXPECT_GT(result.triangles.size(), 39000u);
+  EXPECT_EQ(detail::regionsMapped(), before);
+}
+
+// Where the probe finds first writes cheap, a large block comes from the
+// heap: aligned like a region's, mapping none.
+TEST(HugePages, WithoutRegionsLargeBlocksComeFromTheHeap) {
+  if (!PCL_MS_HUGE_PAGE_REGIONS)
+    GTEST_SKIP() << "regions are off in this build (AddressSanitizer or not Linux)";
+  const RegionsChosen regions(false);
+  const std::size_t before = detail::regionsMapped();
+  HugePageAllocator<double> allocator;
+  const std::size_t count = (std::size_t(1) << 20) / sizeof(double);
+  std::vector<double *> blocks;
+  for (int i = 0; i < 4; ++i) {
+    blocks.push_back(allocator.allocate(count));
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(blocks.back()) % 64, 0u);
+    std::fill(blocks.back(), blocks.back() + count, double(i));
+  }
+  EXPECT_EQ(detail::regionsMapped(), before);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(blocks[i][0], double(i));
+    EXPECT_EQ(blocks[i][count - 1], double(i));
+    allocator.deallocate(blocks[i], count);
+  }
+}
+
+// A block goes back where it came from, even when the choice changed since.
+TEST(HugePages, BlocksGoBackWhereTheyCameFromAfterTheChoiceChanges) {
+  if (!PCL_MS_HUGE_PAGE_REGIONS)
+    GTEST_SKIP() << "regions are off in this build (AddressSanitizer or not Linux)";
+  const std::size_t before = detail::regionsMapped();
+  HugePageAllocator<char> allocator;
+  const std::size_t bytes = std::size_t(1) << 20;
+  char *from_region = nullptr, *from_heap = nullptr;
+  {
+    const RegionsChosen regions(true);
+    from_region = allocator.allocate(bytes);
+  }
+  EXPECT_EQ(detail::regionsMapped(), before + 1);
+  {
+    const RegionsChosen regions(false);
+    from_heap = allocator.allocate(bytes);
+    std::memset(from_heap, 2, bytes);
+    std::memset(from_region, 1, bytes);
+    allocator.deallocate(from_region, bytes);
+  }
+  EXPECT_EQ(detail::regionsMapped(), before);
+  {
+    const RegionsChosen regions(true);
+    EXPECT_EQ(from_heap[bytes - 1], 2);
+    allocator.deallocate(from_heap, bytes);
+  }
   EXPECT_EQ(detail::regionsMapped(), before);
 }
 
