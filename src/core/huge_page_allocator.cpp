@@ -4,10 +4,7 @@
 #include "huge_page_allocator.h"
 #include "populate_pages.h"
 
-#include <algorithm>
-#include <array>
 #include <atomic>
-#include <chrono>
 #include <cstdint>
 
 #if PCL_MS_HUGE_PAGE_REGIONS
@@ -31,38 +28,6 @@ constexpr std::size_t region_bytes = 16 * huge_page_bytes;
 // block's 64-byte alignment.
 constexpr std::size_t block_header = 64;
 
-// Regions pay where a first write to a fresh 4 kB page costs more than
-// this: about 15 µs on the machines where huge pages made the triangulation
-// faster, about 1 µs on one where they made it slower (bench/README.md, "The
-// triangulation's store on huge pages where faults are slow").
-constexpr double slow_first_write_seconds = 5e-6;
-// Pages the probe writes: its median ignores a few preempted writes.
-constexpr std::size_t probe_pages = 64;
-
-/// The median time of a first write to a fresh 4 kB page; 0 where no memory
-/// could be mapped.
-double medianFirstWriteSeconds() {
-  const auto page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
-  void *mapped =
-      mmap(nullptr, probe_pages * page, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-  if (mapped == MAP_FAILED)
-    return 0;
-  madvise(mapped, probe_pages * page, MADV_NOHUGEPAGE);
-  volatile char *bytes = static_cast<volatile char *>(mapped);
-  std::array<double, probe_pages> seconds{};
-  for (std::size_t i = 0; i < probe_pages; ++i) {
-    const auto start = std::chrono::steady_clock::now();
-    bytes[i * page] = 1;
-    seconds[i] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  }
-  munmap(mapped, probe_pages * page);
-  std::nth_element(seconds.begin(), seconds.begin() + probe_pages / 2, seconds.end());
-  return seconds[probe_pages / 2];
-}
-
-// -1 until chosen, then 1 for regions, 0 for the heap.
-std::atomic<int> regions_chosen{-1};
-
 /// Sits at the start of its region. `references` counts the live blocks,
 /// plus one while the region is its thread's current one; `used` is moved
 /// only by that thread.
@@ -77,7 +42,7 @@ std::size_t roundUp(std::size_t value, std::size_t step) {
 }
 
 /// `bytes` (a multiple of huge_page_bytes) aligned to a huge page, advised onto
-/// huge pages, with one reference.
+/// huge pages or off them (hugePagesPay()), with one reference.
 Region *mapRegion(std::size_t bytes) {
   void *mapped = mmap(nullptr, bytes + huge_page_bytes, PROT_READ | PROT_WRITE,
                       MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
@@ -93,8 +58,9 @@ Region *mapRegion(std::size_t bytes) {
     munmap(reinterpret_cast<void *>(aligned + bytes), start + huge_page_bytes - aligned);
   void *region_start = reinterpret_cast<void *>(aligned);
   // A hint: where the kernel has transparent huge pages off, the region is
-  // ordinary memory.
-  madvise(region_start, bytes, MADV_HUGEPAGE);
+  // ordinary memory. Where they do not pay, the region asks for 4 kB pages,
+  // also from a kernel that would make huge pages unasked.
+  madvise(region_start, bytes, hugePagesPay() ? MADV_HUGEPAGE : MADV_NOHUGEPAGE);
   regions_mapped.fetch_add(1, std::memory_order_relaxed);
   return new (region_start) Region{{1}, bytes, block_header};
 }
@@ -132,33 +98,10 @@ void *placeBlock(Region *region, std::size_t bytes) {
 
 #if PCL_MS_HUGE_PAGE_REGIONS
 
-bool regionsInUse() {
-  int chosen = regions_chosen.load(std::memory_order_acquire);
-  if (chosen < 0) {
-    // Threads that get here together may each measure; the first choice stored stays.
-    int undecided = -1;
-    regions_chosen.compare_exchange_strong(
-        undecided, medianFirstWriteSeconds() > slow_first_write_seconds ? 1 : 0,
-        std::memory_order_acq_rel);
-    chosen = regions_chosen.load(std::memory_order_acquire);
-  }
-  return chosen == 1;
-}
-
-void useRegions(bool on) { regions_chosen.store(on ? 1 : 0, std::memory_order_release); }
-
 void *allocateFromRegion(std::size_t bytes) {
   // More than the address space holds; rounding it up below would wrap.
   if (bytes > std::size_t(-1) / 4)
     throw std::bad_alloc();
-  if (!regionsInUse()) {
-    // From the heap, with a header that names no region, so that the block
-    // goes back to the heap whatever is chosen by then.
-    auto *base =
-        static_cast<char *>(::operator new (bytes + block_header, std::align_val_t{block_header}));
-    *reinterpret_cast<Region **>(base) = nullptr;
-    return base + block_header;
-  }
   const std::size_t needed = roundUp(bytes, 64) + block_header;
   if (needed > region_bytes - block_header) {
     // A block larger than a region gets one of its own, unshared.
@@ -180,10 +123,6 @@ void *allocateFromRegion(std::size_t bytes) {
 void deallocateToRegion(void *block) noexcept {
   char *base = static_cast<char *>(block) - block_header;
   Region *region = *reinterpret_cast<Region **>(base);
-  if (!region) {
-    ::operator delete (base, std::align_val_t{block_header});
-    return;
-  }
   // The thread's last block in its current region: the region goes with it,
   // so that a finished triangulation leaves no memory behind (a reference
   // alone would keep its touched pages until the thread allocates again).
@@ -195,10 +134,6 @@ void deallocateToRegion(void *block) noexcept {
 }
 
 #else
-
-bool regionsInUse() { return false; }
-
-void useRegions(bool) {}
 
 void *allocateFromRegion(std::size_t bytes) { return ::operator new(bytes); }
 

@@ -41,19 +41,8 @@ namespace detail {
 /// small cloud's whole triangulation) from the ordinary heap.
 inline constexpr std::size_t huge_page_block_bytes = std::size_t(64) << 10;
 
-/// Whether large blocks come from regions: where a first write to a fresh
-/// 4 kB page is slow (a probe of a few pages, once per process, when the
-/// first large block is asked for). Where page faults are cheap the kernel's
-/// zeroing of a whole huge page at once costs more than the faults it saves,
-/// and large blocks come from the heap.
-bool regionsInUse();
-/// For tests: regions on or off from now on, instead of the probe's choice.
-/// Blocks already given out go back where they came from.
-void useRegions(bool on);
-
 /// A block of `bytes` (at least huge_page_block_bytes), 64-byte aligned,
-/// from the calling thread's current region, or from the heap where
-/// regions are not in use; throws std::bad_alloc.
+/// from the calling thread's current region; throws std::bad_alloc.
 void *allocateFromRegion(std::size_t bytes);
 /// Gives back a block of allocateFromRegion, from any thread. A region is
 /// unmapped when its last block goes and no thread allocates from it.
@@ -62,8 +51,9 @@ void deallocateToRegion(void *block) noexcept;
 std::size_t regionsMapped() noexcept;
 
 /// std::allocator's interface; blocks of huge_page_block_bytes or more come
-/// (where regionsInUse()) from regions of 2 MB-aligned memory advised onto
-/// huge pages, bump allocated, each unmapped when all its blocks are freed.
+/// from regions of 2 MB-aligned memory, advised onto huge pages where they
+/// pay (hugePagesPay()), bump allocated, each unmapped when all its blocks
+/// are freed.
 /// That suits CGAL's Compact_container, which frees all its blocks together:
 /// a triangulation's cells, visited through neighbour pointers all over the
 /// store, then lie on 512 times fewer pages.

@@ -39,6 +39,14 @@ bool hugePagesMadeAtFault() {
          (defrag == "always" || defrag == "madvise" || defrag == "defer+madvise");
 }
 
+/// Whether the kernel makes huge pages only where they are asked for.
+bool hugePagesOnlyOnAdvice() {
+  std::ifstream file("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string line;
+  std::getline(file, line);
+  return line.find("[madvise]") != std::string::npos;
+}
+
 /// AnonHugePages (kB) of the mapping that holds `address`, from /proc/self/smaps.
 long hugePagesKbAt(const void *address) {
   const auto target = reinterpret_cast<std::uintptr_t>(address);
@@ -59,14 +67,16 @@ long hugePagesKbAt(const void *address) {
   return -1;
 }
 
-/// Regions on or off while it lives, whatever the probe chose (each test
-/// sets what it checks; the machine's own choice comes back after it).
-class RegionsChosen {
+/// Huge pages asked for or not while it lives, whatever the probe found
+/// (the machine's own answer comes back after it).
+class HugePagesChosen {
 public:
-  explicit RegionsChosen(bool on) : before_(detail::regionsInUse()) { detail::useRegions(on); }
-  ~RegionsChosen() { detail::useRegions(before_); }
-  RegionsChosen(const RegionsChosen &) = delete;
-  RegionsChosen &operator=(const RegionsChosen &) = delete;
+  explicit HugePagesChosen(bool pay) : before_(detail::hugePagesPay()) {
+    detail::setHugePagesPay(pay);
+  }
+  ~HugePagesChosen() { detail::setHugePagesPay(before_); }
+  HugePagesChosen(const HugePagesChosen &) = delete;
+  HugePagesChosen &operator=(const HugePagesChosen &) = delete;
 
 private:
   bool before_;
@@ -77,7 +87,6 @@ private:
 TEST(HugePages, SmallBlocksComeFromTheHeapAndLargeOnesFromRegionsThatGoWithThem) {
   if (!PCL_MS_HUGE_PAGE_REGIONS)
     GTEST_SKIP() << "regions are off in this build (AddressSanitizer or not Linux)";
-  const RegionsChosen regions(true);
   const std::size_t before = detail::regionsMapped();
   HugePageAllocator<double> allocator;
   double *small = allocator.allocate(100);
@@ -109,7 +118,6 @@ TEST(HugePages, SmallBlocksComeFromTheHeapAndLargeOnesFromRegionsThatGoWithThem)
 TEST(HugePages, BlocksFreedOnAnotherThreadLeaveNoRegionWhenTheirThreadEnds) {
   if (!PCL_MS_HUGE_PAGE_REGIONS)
     GTEST_SKIP() << "regions are off in this build (AddressSanitizer or not Linux)";
-  const RegionsChosen regions(true);
   const std::size_t before = detail::regionsMapped();
   const std::size_t count = (std::size_t(1) << 18) / sizeof(int);
   std::vector<int *> blocks(8, nullptr);
@@ -137,7 +145,7 @@ TEST(HugePages, BlocksFreedOnAnotherThreadLeaveNoRegionWhenTheirThreadEnds) {
 TEST(HugePages, LargeBlocksAreOnHugePagesWhereTheKernelMakesThem) {
   if (!PCL_MS_HUGE_PAGE_REGIONS || !hugePagesMadeAtFault())
     GTEST_SKIP() << "no transparent huge pages at fault here";
-  const RegionsChosen regions(true);
+  const HugePagesChosen huge_pages(true);
   HugePageAllocator<char> allocator;
   const std::size_t bytes = std::size_t(8) << 20;
   char *block = allocator.allocate(bytes);
@@ -147,7 +155,6 @@ TEST(HugePages, LargeBlocksAreOnHugePagesWhereTheKernelMakesThem) {
 }
 
 TEST(HugePages, ReconstructionLeavesNoRegionBehind) {
-  const RegionsChosen regions(true);
   const std::size_t before = detail::regionsMapped();
   const std::vector<float> xyz = fibonacciSphere(20000);
   const Result result = reconstruct(viewOf(xyz), Parameters());
@@ -155,55 +162,21 @@ TEST(HugePages, ReconstructionLeavesNoRegionBehind) {
   EXPECT_EQ(detail::regionsMapped(), before);
 }
 
-// Where the probe finds first writes cheap, a large block comes from the
-// heap: aligned like a region's, mapping none.
-TEST(HugePages, WithoutRegionsLargeBlocksComeFromTheHeap) {
+// Where huge pages do not pay, a large block is on 4 kB pages, also where
+// the kernel would make huge pages unasked.
+TEST(HugePages, WhereTheyDoNotPayLargeBlocksAreOnSmallPages) {
   if (!PCL_MS_HUGE_PAGE_REGIONS)
     GTEST_SKIP() << "regions are off in this build (AddressSanitizer or not Linux)";
-  const RegionsChosen regions(false);
-  const std::size_t before = detail::regionsMapped();
-  HugePageAllocator<double> allocator;
-  const std::size_t count = (std::size_t(1) << 20) / sizeof(double);
-  std::vector<double *> blocks;
-  for (int i = 0; i < 4; ++i) {
-    blocks.push_back(allocator.allocate(count));
-    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(blocks.back()) % 64, 0u);
-    std::fill(blocks.back(), blocks.back() + count, double(i));
-  }
-  EXPECT_EQ(detail::regionsMapped(), before);
-  for (int i = 0; i < 4; ++i) {
-    EXPECT_EQ(blocks[i][0], double(i));
-    EXPECT_EQ(blocks[i][count - 1], double(i));
-    allocator.deallocate(blocks[i], count);
-  }
-}
-
-// A block goes back where it came from, even when the choice changed since.
-TEST(HugePages, BlocksGoBackWhereTheyCameFromAfterTheChoiceChanges) {
-  if (!PCL_MS_HUGE_PAGE_REGIONS)
-    GTEST_SKIP() << "regions are off in this build (AddressSanitizer or not Linux)";
+  const HugePagesChosen huge_pages(false);
   const std::size_t before = detail::regionsMapped();
   HugePageAllocator<char> allocator;
-  const std::size_t bytes = std::size_t(1) << 20;
-  char *from_region = nullptr, *from_heap = nullptr;
-  {
-    const RegionsChosen regions(true);
-    from_region = allocator.allocate(bytes);
-  }
+  const std::size_t bytes = std::size_t(8) << 20;
+  char *block = allocator.allocate(bytes);
   EXPECT_EQ(detail::regionsMapped(), before + 1);
-  {
-    const RegionsChosen regions(false);
-    from_heap = allocator.allocate(bytes);
-    std::memset(from_heap, 2, bytes);
-    std::memset(from_region, 1, bytes);
-    allocator.deallocate(from_region, bytes);
-  }
-  EXPECT_EQ(detail::regionsMapped(), before);
-  {
-    const RegionsChosen regions(true);
-    EXPECT_EQ(from_heap[bytes - 1], 2);
-    allocator.deallocate(from_heap, bytes);
-  }
+  std::memset(block, 3, bytes);
+  EXPECT_EQ(hugePagesKbAt(block), 0);
+  EXPECT_EQ(block[bytes - 1], 3);
+  allocator.deallocate(block, bytes);
   EXPECT_EQ(detail::regionsMapped(), before);
 }
 
@@ -212,9 +185,24 @@ TEST(HugePages, BlocksGoBackWhereTheyCameFromAfterTheChoiceChanges) {
 TEST(HugePages, ArraysResizedForWritingAreOnHugePagesWhereTheKernelMakesThem) {
   if (!hugePagesMadeAtFault())
     GTEST_SKIP() << "no transparent huge pages at fault here";
+  const HugePagesChosen huge_pages(true);
   std::vector<std::uint64_t> values;
   detail::resizeForWriting(values, std::size_t(1) << 20); // 8 MB: 3 whole huge pages at least
   std::fill(values.begin(), values.end(), 5u);
   EXPECT_GE(hugePagesKbAt(values.data() + values.size() / 2), 2048);
   EXPECT_EQ(values.back(), 5u);
+}
+
+// Where huge pages do not pay, the arrays do not ask for them. 40 MB: above
+// glibc's largest threshold for mapping a block of its own, so the pages
+// are fresh, not ones an earlier test had on huge pages.
+TEST(HugePages, WhereTheyDoNotPayArraysResizedForWritingAreOnSmallPages) {
+  if (!hugePagesOnlyOnAdvice())
+    GTEST_SKIP() << "the kernel does not make huge pages only on advice here";
+  const HugePagesChosen huge_pages(false);
+  std::vector<std::uint64_t> values;
+  detail::resizeForWriting(values, std::size_t(5) << 20);
+  std::fill(values.begin(), values.end(), 6u);
+  EXPECT_EQ(hugePagesKbAt(values.data() + values.size() / 2), 0);
+  EXPECT_EQ(values.back(), 6u);
 }
