@@ -85,8 +85,9 @@ void populateForWriting(const void *data, std::size_t bytes) noexcept {
   const auto start = reinterpret_cast<std::uintptr_t>(data);
   // Where huge pages pay, the whole huge pages inside go on them, like the
   // triangulation's store (huge_page_allocator.h): one fault each instead
-  // of 512.
-  if (hugePagesPay())
+  // of 512. Shorter ranges hold none, and do not run the probe: a small
+  // cloud's call never pays for it.
+  if (bytes >= huge_page_bytes && hugePagesPay())
     advise(start, bytes, huge_page_bytes, MADV_HUGEPAGE);
   advise(start, bytes, page, populate_write_advice);
 }

@@ -19,8 +19,9 @@ inline constexpr std::size_t min_populated_bytes = std::size_t(16) << 10;
 inline constexpr std::size_t huge_page_bytes = std::size_t(2) << 20;
 
 /// Whether transparent huge pages pay here: where a first write to a fresh
-/// 4 kB page is slow (a probe of a few pages, once per process, at the first
-/// question). Where page faults are cheap the kernel's zeroing of a whole
+/// 4 kB page is slow (a probe of a few pages, once per process, when the
+/// first region is mapped or the first array of 2 MB or more populated;
+/// never for a small cloud). Where page faults are cheap the kernel's zeroing of a whole
 /// huge page at once costs more than the 511 faults it saves, and neither
 /// the triangulation's store nor the populated arrays ask for huge pages.
 /// Always false outside Linux.
