@@ -9,7 +9,6 @@
 
 #if PCL_MS_HUGE_PAGE_REGIONS
 #include <sys/mman.h>
-#include <unistd.h>
 #endif
 
 namespace pcl_ms {

@@ -51,8 +51,7 @@ double medianFirstWriteSeconds() {
   return seconds[probe_pages / 2];
 }
 
-// -1 until the probe ran, then 1 where huge pages pay, 0 where not.
-std::atomic<int> huge_pages_pay{-1};
+std::atomic<HugePagesChoice> huge_pages_choice{HugePagesChoice::undecided};
 
 /// The whole pages of size `page` inside [start, start + bytes), advised.
 void advise(std::uintptr_t start, std::size_t bytes, std::uintptr_t page, int advice) noexcept {
@@ -64,19 +63,25 @@ void advise(std::uintptr_t start, std::size_t bytes, std::uintptr_t page, int ad
 } // namespace
 
 bool hugePagesPay() {
-  int chosen = huge_pages_pay.load(std::memory_order_acquire);
-  if (chosen < 0) {
+  HugePagesChoice chosen = huge_pages_choice.load(std::memory_order_acquire);
+  if (chosen == HugePagesChoice::undecided) {
     // Threads that get here together may each measure; the first answer stored stays.
-    int undecided = -1;
-    huge_pages_pay.compare_exchange_strong(
-        undecided, medianFirstWriteSeconds() > slow_first_write_seconds ? 1 : 0,
-        std::memory_order_acq_rel);
-    chosen = huge_pages_pay.load(std::memory_order_acquire);
+    auto undecided = HugePagesChoice::undecided;
+    huge_pages_choice.compare_exchange_strong(undecided,
+                                              medianFirstWriteSeconds() > slow_first_write_seconds
+                                                  ? HugePagesChoice::pay
+                                                  : HugePagesChoice::do_not_pay,
+                                              std::memory_order_acq_rel);
+    chosen = huge_pages_choice.load(std::memory_order_acquire);
   }
-  return chosen == 1;
+  return chosen == HugePagesChoice::pay;
 }
 
-void setHugePagesPay(bool pay) { huge_pages_pay.store(pay ? 1 : 0, std::memory_order_release); }
+HugePagesChoice hugePagesChoice() { return huge_pages_choice.load(std::memory_order_acquire); }
+
+void setHugePagesChoice(HugePagesChoice choice) {
+  huge_pages_choice.store(choice, std::memory_order_release);
+}
 
 void populateForWriting(const void *data, std::size_t bytes) noexcept {
   if (bytes < min_populated_bytes)
@@ -96,7 +101,9 @@ void populateForWriting(const void *data, std::size_t bytes) noexcept {
 
 bool hugePagesPay() { return false; }
 
-void setHugePagesPay(bool) {}
+HugePagesChoice hugePagesChoice() { return HugePagesChoice::do_not_pay; }
+
+void setHugePagesChoice(HugePagesChoice) {}
 
 void populateForWriting(const void *, std::size_t) noexcept {}
 

@@ -19,23 +19,28 @@ inline constexpr std::size_t min_populated_bytes = std::size_t(16) << 10;
 inline constexpr std::size_t huge_page_bytes = std::size_t(2) << 20;
 
 /// Whether transparent huge pages pay here: where a first write to a fresh
-/// 4 kB page is slow (a probe of a few pages, once per process, when the
-/// first region is mapped or the first array of 2 MB or more populated;
-/// never for a small cloud). Where page faults are cheap the kernel's zeroing of a whole
-/// huge page at once costs more than the 511 faults it saves, and neither
-/// the triangulation's store nor the populated arrays ask for huge pages.
-/// Always false outside Linux.
+/// 4 kB page is slow. A probe of a few pages decides, once per process,
+/// when the first region is mapped or the first array of 2 MB or more is
+/// populated, so a small cloud never pays for it. Where page faults are
+/// cheap the kernel's zeroing of a whole huge page at once costs more than
+/// the 511 faults it saves, and neither the triangulation's store nor the
+/// populated arrays ask for huge pages. Always false outside Linux.
 bool hugePagesPay();
-/// For tests: the answer of hugePagesPay() from now on, instead of the probe's.
-void setHugePagesPay(bool pay);
+
+/// The answer hugePagesPay() gives, or that the probe has not run yet.
+enum class HugePagesChoice { undecided, pay, do_not_pay };
+/// For tests: the choice so far (never undecided outside Linux).
+HugePagesChoice hugePagesChoice();
+/// For tests: the choice from now on; `undecided` has the probe run again.
+void setHugePagesChoice(HugePagesChoice choice);
 
 /// Has the kernel fault in, writable, every whole page of [data, data +
 /// bytes) in one call (Linux 5.14's MADV_POPULATE_WRITE) instead of one
 /// fault per page at the first write. Where hugePagesPay(), the whole huge
-/// pages inside the range are advised onto transparent huge pages first. Only for memory the caller
-/// is about to write in full. The contents stay as they were. Nothing happens on other systems, on
-/// older kernels or when it fails: it only changes how fast the first
-/// writes go.
+/// pages inside the range are advised onto transparent huge pages first.
+/// Only for memory the caller is about to write in full. The contents stay
+/// as they were. Nothing happens on other systems, on older kernels or when
+/// it fails: it only changes how fast the first writes go.
 void populateForWriting(const void *data, std::size_t bytes) noexcept;
 
 /// populateForWriting() of a vector's whole capacity.

@@ -23,28 +23,30 @@ using pcl_ms_test::viewOf;
 
 namespace {
 
+/// The selected value of a transparent huge page setting, the word in
+/// brackets in the file; empty where there is no such file.
+std::string selectedSetting(const char *path) {
+  std::ifstream file(path);
+  std::string line;
+  std::getline(file, line);
+  const auto open = line.find('['), close = line.find(']');
+  return open == std::string::npos || close == std::string::npos
+             ? std::string()
+             : line.substr(open + 1, close - open - 1);
+}
+
 /// Whether the kernel backs madvise'd memory with huge pages and makes them
 /// at the fault ("madvise" or "always" for both), so that a test may expect them.
 bool hugePagesMadeAtFault() {
-  auto selected = [](const char *path) {
-    std::ifstream file(path);
-    std::string line;
-    std::getline(file, line);
-    const auto open = line.find('['), close = line.find(']');
-    return open == std::string::npos ? std::string() : line.substr(open + 1, close - open - 1);
-  };
-  const std::string enabled = selected("/sys/kernel/mm/transparent_hugepage/enabled");
-  const std::string defrag = selected("/sys/kernel/mm/transparent_hugepage/defrag");
+  const std::string enabled = selectedSetting("/sys/kernel/mm/transparent_hugepage/enabled");
+  const std::string defrag = selectedSetting("/sys/kernel/mm/transparent_hugepage/defrag");
   return (enabled == "always" || enabled == "madvise") &&
          (defrag == "always" || defrag == "madvise" || defrag == "defer+madvise");
 }
 
 /// Whether the kernel makes huge pages only where they are asked for.
 bool hugePagesOnlyOnAdvice() {
-  std::ifstream file("/sys/kernel/mm/transparent_hugepage/enabled");
-  std::string line;
-  std::getline(file, line);
-  return line.find("[madvise]") != std::string::npos;
+  return selectedSetting("/sys/kernel/mm/transparent_hugepage/enabled") == "madvise";
 }
 
 /// AnonHugePages (kB) of the mapping that holds `address`, from /proc/self/smaps.
@@ -67,19 +69,19 @@ long hugePagesKbAt(const void *address) {
   return -1;
 }
 
-/// Huge pages asked for or not while it lives, whatever the probe found
-/// (the machine's own answer comes back after it).
+/// Huge pages asked for, not asked for or left to the probe while it lives,
+/// whatever was chosen before (that choice comes back after it).
 class HugePagesChosen {
 public:
-  explicit HugePagesChosen(bool pay) : before_(detail::hugePagesPay()) {
-    detail::setHugePagesPay(pay);
+  explicit HugePagesChosen(detail::HugePagesChoice choice) : before_(detail::hugePagesChoice()) {
+    detail::setHugePagesChoice(choice);
   }
-  ~HugePagesChosen() { detail::setHugePagesPay(before_); }
+  ~HugePagesChosen() { detail::setHugePagesChoice(before_); }
   HugePagesChosen(const HugePagesChosen &) = delete;
   HugePagesChosen &operator=(const HugePagesChosen &) = delete;
 
 private:
-  bool before_;
+  detail::HugePagesChoice before_;
 };
 
 } // namespace
@@ -145,7 +147,7 @@ TEST(HugePages, BlocksFreedOnAnotherThreadLeaveNoRegionWhenTheirThreadEnds) {
 TEST(HugePages, LargeBlocksAreOnHugePagesWhereTheKernelMakesThem) {
   if (!PCL_MS_HUGE_PAGE_REGIONS || !hugePagesMadeAtFault())
     GTEST_SKIP() << "no transparent huge pages at fault here";
-  const HugePagesChosen huge_pages(true);
+  const HugePagesChosen huge_pages(detail::HugePagesChoice::pay);
   HugePageAllocator<char> allocator;
   const std::size_t bytes = std::size_t(8) << 20;
   char *block = allocator.allocate(bytes);
@@ -167,7 +169,7 @@ TEST(HugePages, ReconstructionLeavesNoRegionBehind) {
 TEST(HugePages, WhereTheyDoNotPayLargeBlocksAreOnSmallPages) {
   if (!PCL_MS_HUGE_PAGE_REGIONS)
     GTEST_SKIP() << "regions are off in this build (AddressSanitizer or not Linux)";
-  const HugePagesChosen huge_pages(false);
+  const HugePagesChosen huge_pages(detail::HugePagesChoice::do_not_pay);
   const std::size_t before = detail::regionsMapped();
   HugePageAllocator<char> allocator;
   const std::size_t bytes = std::size_t(8) << 20;
@@ -185,7 +187,7 @@ TEST(HugePages, WhereTheyDoNotPayLargeBlocksAreOnSmallPages) {
 TEST(HugePages, ArraysResizedForWritingAreOnHugePagesWhereTheKernelMakesThem) {
   if (!hugePagesMadeAtFault())
     GTEST_SKIP() << "no transparent huge pages at fault here";
-  const HugePagesChosen huge_pages(true);
+  const HugePagesChosen huge_pages(detail::HugePagesChoice::pay);
   std::vector<std::uint64_t> values;
   detail::resizeForWriting(values, std::size_t(1) << 20); // 8 MB: 3 whole huge pages at least
   std::fill(values.begin(), values.end(), 5u);
@@ -199,10 +201,26 @@ TEST(HugePages, ArraysResizedForWritingAreOnHugePagesWhereTheKernelMakesThem) {
 TEST(HugePages, WhereTheyDoNotPayArraysResizedForWritingAreOnSmallPages) {
   if (!hugePagesOnlyOnAdvice())
     GTEST_SKIP() << "the kernel does not make huge pages only on advice here";
-  const HugePagesChosen huge_pages(false);
+  const HugePagesChosen huge_pages(detail::HugePagesChoice::do_not_pay);
   std::vector<std::uint64_t> values;
   detail::resizeForWriting(values, std::size_t(5) << 20);
   std::fill(values.begin(), values.end(), 6u);
   EXPECT_EQ(hugePagesKbAt(values.data() + values.size() / 2), 0);
   EXPECT_EQ(values.back(), 6u);
+}
+
+// The probe runs only where huge pages could matter: an array below one
+// huge page holds none, so populating it leaves the choice open, and a
+// small cloud never pays for the probe.
+TEST(HugePages, OnlyArraysOfAHugePageOrMoreRunTheProbe) {
+#if !defined(__linux__)
+  GTEST_SKIP() << "no probe outside Linux";
+#endif
+  const HugePagesChosen huge_pages(detail::HugePagesChoice::undecided);
+  std::vector<std::uint64_t> small;
+  detail::resizeForWriting(small, detail::huge_page_bytes / sizeof(std::uint64_t) / 2);
+  EXPECT_EQ(detail::hugePagesChoice(), detail::HugePagesChoice::undecided);
+  std::vector<std::uint64_t> large;
+  detail::resizeForWriting(large, detail::huge_page_bytes / sizeof(std::uint64_t) * 2);
+  EXPECT_NE(detail::hugePagesChoice(), detail::HugePagesChoice::undecided);
 }
