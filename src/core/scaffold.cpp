@@ -90,14 +90,16 @@ constexpr double min_fast_gabriel_compactness = 1e-4;
 constexpr double fast_gabriel_margin = 1e-6;
 
 /// isGabriel() with a floating-point filter: the apexes are compared with
-/// the circumcircle that the cost needs anyway, and only near-ties (or
-/// needles) pay for the exact predicate. Same answer, a fraction of the time.
+/// the circumcircle that the local scale needs anyway, and only near-ties
+/// (or needles) pay for the exact predicate. Same answer, a fraction of the
+/// time. `needle`: the facet is less compact than
+/// min_fast_gabriel_compactness. The radius is given squared: most facets
+/// are not Gabriel, and a square root would be waited for in vain.
 bool isGabriel(const Delaunay &delaunay, CellHandle cell, int i,
-               const std::array<VertexHandle, 3> &vertices, const Circle &circle,
-               double compactness) {
-  if (compactness < min_fast_gabriel_compactness)
+               const std::array<VertexHandle, 3> &vertices, const Eigen::Vector3d &centre,
+               double radius_squared, bool needle) {
+  if (needle)
     return isGabriel(delaunay, cell, i, vertices);
-  const double radius_squared = circle.radius * circle.radius;
   const double margin = fast_gabriel_margin * radius_squared;
   const CellHandle neighbour = cell->neighbor(i);
   const VertexHandle opposite[2] = {cell->vertex(i), neighbour->vertex(neighbour->index(cell))};
@@ -105,8 +107,7 @@ bool isGabriel(const Delaunay &delaunay, CellHandle cell, int i,
     if (delaunay.is_infinite(apex))
       continue;
     const KernelPoint &p = apex->point();
-    const double distance_squared =
-        (Eigen::Vector3d(p.x(), p.y(), p.z()) - circle.centre).squaredNorm();
+    const double distance_squared = (Eigen::Vector3d(p.x(), p.y(), p.z()) - centre).squaredNorm();
     if (distance_squared < radius_squared - margin)
       return false;
     if (distance_squared <= radius_squared + margin)
@@ -125,23 +126,25 @@ struct EdgeVectors {
   double uu, vv, ww;
 };
 
-/// The circumcircle of the triangle with corner a and edge vectors `edges`;
-/// its unit normal only if asked for (the local scales, which see every
-/// facet, need centre and radius only). None where it does not exist in
-/// double precision, though the corners are not collinear: edge vectors that
-/// round to parallel ones (a far corner beside two close ones), or
-/// |u x v|^2 out of range. Callers leave such a facet out as degenerate.
-std::optional<Circle> circumcircle(const Eigen::Vector3d &a, const EdgeVectors &edges,
-                                   bool with_normal = true) {
+/// The circumcentre of the triangle with corner a and edge vectors `edges`,
+/// as an offset from a (its length is the circumradius).
+Eigen::Vector3d circumcentreOffset(const EdgeVectors &edges) {
+  return (edges.uu * edges.v.cross(edges.w) + edges.vv * edges.w.cross(edges.u)) / (2.0 * edges.ww);
+}
+
+/// The circumcircle of the triangle with corner a and edge vectors `edges`.
+/// None where it does not exist in double precision, though the corners are
+/// not collinear: edge vectors that round to parallel ones (a far corner
+/// beside two close ones), or |u x v|^2 out of range. Callers leave such a
+/// facet out as degenerate.
+std::optional<Circle> circumcircle(const Eigen::Vector3d &a, const EdgeVectors &edges) {
   Circle circle;
-  const Eigen::Vector3d offset =
-      (edges.uu * edges.v.cross(edges.w) + edges.vv * edges.w.cross(edges.u)) / (2.0 * edges.ww);
+  const Eigen::Vector3d offset = circumcentreOffset(edges);
   circle.centre = a + offset;
   circle.radius = offset.norm();
   if (!std::isfinite(circle.radius))
     return std::nullopt;
-  if (with_normal)
-    circle.unit_normal = edges.w / std::sqrt(edges.ww);
+  circle.unit_normal = edges.w / std::sqrt(edges.ww);
   return circle;
 }
 
@@ -394,25 +397,31 @@ private:
                     kinds.push_back(FacetKind::collinear);
                     return;
                   }
-                  const std::optional<Circle> found = circumcircle(p, edges, false);
-                  if (!found) { // left out like a collinear facet
+                  // The circumcircle, as circumcircle() finds it: a squared
+                  // radius out of range is a missing circle.
+                  const Eigen::Vector3d offset = circumcentreOffset(edges);
+                  const double radius_squared = offset.squaredNorm();
+                  if (!std::isfinite(radius_squared)) { // left out like a collinear facet
                     kinds.push_back(FacetKind::collinear);
                     return;
                   }
-                  const Circle &circle = *found;
-                  // 4 sqrt(3) A / (d1^2 + d2^2 + d3^2), A = |w| / 2.
-                  const double compactness =
-                      2 * std::sqrt(3.0) * std::sqrt(edges.ww) /
-                      (edges.uu + edges.vv + (edges.v - edges.u).squaredNorm());
-                  const bool is_gabriel = scaffold_.planar || isGabriel(delaunay, cell, i, vertices,
-                                                                        circle, compactness);
+                  // Compactness 4 sqrt(3) A / (d1^2 + d2^2 + d3^2), A = |w| / 2,
+                  // compared squared: no root, no division.
+                  const double sum_of_squares =
+                      edges.uu + edges.vv + (edges.v - edges.u).squaredNorm();
+                  const bool needle = 12 * edges.ww < min_fast_gabriel_compactness *
+                                                          min_fast_gabriel_compactness *
+                                                          sum_of_squares * sum_of_squares;
+                  const bool is_gabriel =
+                      scaffold_.planar ||
+                      isGabriel(delaunay, cell, i, vertices, p + offset, radius_squared, needle);
                   if (!is_gabriel) {
                     kinds.push_back(FacetKind::other);
                     return;
                   }
                   gabriel.push_back(
                       {{vertices[0]->info(), vertices[1]->info(), vertices[2]->info()},
-                       static_cast<float>(circle.radius)});
+                       static_cast<float>(std::sqrt(radius_squared))});
                   kinds.push_back(scaffold_.planar ? FacetKind::gabriel_planar
                                                    : typeGabriel(delaunay, cell, i, sorted,
                                                                  vertices, facets.shock_lengths));

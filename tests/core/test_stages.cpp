@@ -294,6 +294,44 @@ TEST(Scaffold, AcuteAndObtuseTypesAgreeWithExactAngles) {
   }
 }
 
+// Types I and II are the Gabriel facets: no point strictly inside the
+// smallest sphere through the corners, by CGAL's exact test against every
+// point. On a grid every such sphere has points on it (exact fallback); a
+// jitter of 1e-9 leaves near-ties within the filter's margin; a jitter of 0.3
+// lets the floating-point filter decide.
+TEST(Scaffold, GabrielTypesAgreeWithExactDiametralSpheres) {
+  using ExactPoint = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
+  const auto side_of_bounded_sphere =
+      CGAL::Exact_predicates_inexact_constructions_kernel().side_of_bounded_sphere_3_object();
+  for (double jitter : {0.0, 1e-9, 0.3}) {
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> offset(-jitter, jitter);
+    std::vector<Eigen::Vector3d> points;
+    for (int x = 0; x < 5; ++x)
+      for (int y = 0; y < 5; ++y)
+        for (int z = 0; z < 5; ++z)
+          points.emplace_back(x + offset(random), y + offset(random), z + offset(random));
+    std::vector<ExactPoint> exact;
+    for (const Eigen::Vector3d &p : points)
+      exact.emplace_back(p.x(), p.y(), p.z());
+    ScaffoldOptions options;
+    options.rho = 100; // every facet is a candidate
+    const MedialScaffold scaffold = buildMedialScaffold(points, options);
+    std::size_t gabriel = 0, other = 0;
+    for (const Candidate &candidate : scaffold.candidates) {
+      const auto &[a, b, c] = candidate.vertices;
+      const bool empty = std::none_of(exact.begin(), exact.end(), [&](const ExactPoint &p) {
+        return side_of_bounded_sphere(exact[a], exact[b], exact[c], p) == CGAL::ON_BOUNDED_SIDE;
+      });
+      EXPECT_EQ(candidate.type != CandidateType::ambiguous, empty)
+          << "jitter " << jitter << ", facet " << a << " " << b << " " << c;
+      ++(empty ? gabriel : other);
+    }
+    EXPECT_GT(gabriel, 200u) << "jitter " << jitter;
+    EXPECT_GT(other, 100u) << "jitter " << jitter;
+  }
+}
+
 TEST(Scaffold, TriangleWithPointInItsDiametralSphereIsTypeThree) {
   // d hovers just above abc, well inside the sphere through a, b, c centred in their plane.
   const std::vector<Eigen::Vector3d> points = {
