@@ -76,10 +76,11 @@ bool isGabriel(const Delaunay &delaunay, CellHandle cell, int i,
   return true;
 }
 
+/// A facet's circumcircle as its shock length and normal term read it: the
+/// radius, which the facet pass finds on its own, is not kept.
 struct Circle {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   Eigen::Vector3d unit_normal = Eigen::Vector3d::Zero();
-  double radius = 0;
 };
 
 // Below this compactness the floating-point circumcentre may be off by more
@@ -141,8 +142,7 @@ std::optional<Circle> circumcircle(const Eigen::Vector3d &a, const EdgeVectors &
   Circle circle;
   const Eigen::Vector3d offset = circumcentreOffset(edges);
   circle.centre = a + offset;
-  circle.radius = offset.norm();
-  if (!std::isfinite(circle.radius))
+  if (!std::isfinite(offset.squaredNorm())) // the radius out of range
     return std::nullopt;
   circle.unit_normal = edges.w / std::sqrt(edges.ww);
   return circle;
