@@ -256,19 +256,30 @@ TEST(Scaffold, ObtuseGabrielTriangleIsTypeTwo) {
   EXPECT_EQ(base->type, CandidateType::obtuse);
 }
 
+namespace {
+
+/// A 5 x 5 x 5 grid of unit spacing, each coordinate moved by up to
+/// `jitter` (uniform, seeded).
+std::vector<Eigen::Vector3d> jitteredGrid(double jitter, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> offset(-jitter, jitter);
+  std::vector<Eigen::Vector3d> points;
+  for (int x = 0; x < 5; ++x)
+    for (int y = 0; y < 5; ++y)
+      for (int z = 0; z < 5; ++z)
+        points.emplace_back(x + offset(random), y + offset(random), z + offset(random));
+  return points;
+}
+
+} // namespace
+
 // On a grid, right angles and co-circular corners go to CGAL's exact tests;
 // on a jittered grid the floating-point filters decide: both must give the
 // exact verdict on every Gabriel candidate.
 TEST(Scaffold, AcuteAndObtuseTypesAgreeWithExactAngles) {
   using ExactPoint = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
   for (double jitter : {0.0, 0.3}) {
-    std::mt19937 random(7);
-    std::uniform_real_distribution<double> offset(-jitter, jitter);
-    std::vector<Eigen::Vector3d> points;
-    for (int x = 0; x < 5; ++x)
-      for (int y = 0; y < 5; ++y)
-        for (int z = 0; z < 5; ++z)
-          points.emplace_back(x + offset(random), y + offset(random), z + offset(random));
+    const std::vector<Eigen::Vector3d> points = jitteredGrid(jitter, 7);
     ScaffoldOptions options;
     options.rho = 100; // every facet is a candidate
     const MedialScaffold scaffold = buildMedialScaffold(points, options);
@@ -304,13 +315,7 @@ TEST(Scaffold, GabrielTypesAgreeWithExactDiametralSpheres) {
   const auto side_of_bounded_sphere =
       CGAL::Exact_predicates_inexact_constructions_kernel().side_of_bounded_sphere_3_object();
   for (double jitter : {0.0, 1e-9, 0.3}) {
-    std::mt19937 random(11);
-    std::uniform_real_distribution<double> offset(-jitter, jitter);
-    std::vector<Eigen::Vector3d> points;
-    for (int x = 0; x < 5; ++x)
-      for (int y = 0; y < 5; ++y)
-        for (int z = 0; z < 5; ++z)
-          points.emplace_back(x + offset(random), y + offset(random), z + offset(random));
+    const std::vector<Eigen::Vector3d> points = jitteredGrid(jitter, 11);
     std::vector<ExactPoint> exact;
     for (const Eigen::Vector3d &p : points)
       exact.emplace_back(p.x(), p.y(), p.z());
