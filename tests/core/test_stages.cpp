@@ -324,7 +324,8 @@ TEST(Scaffold, GabrielTypesAgreeWithExactDiametralSpheres) {
     const MedialScaffold scaffold = buildMedialScaffold(points, options);
     std::size_t gabriel = 0, other = 0;
     for (const Candidate &candidate : scaffold.candidates) {
-      const auto &[a, b, c] = candidate.vertices;
+      const VertexIndex a = candidate.vertices[0], b = candidate.vertices[1],
+                        c = candidate.vertices[2];
       const bool empty = std::none_of(exact.begin(), exact.end(), [&](const ExactPoint &p) {
         return side_of_bounded_sphere(exact[a], exact[b], exact[c], p) == CGAL::ON_BOUNDED_SIDE;
       });
