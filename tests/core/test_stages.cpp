@@ -307,9 +307,9 @@ TEST(Scaffold, AcuteAndObtuseTypesAgreeWithExactAngles) {
 
 // Types I and II are the Gabriel facets: no point strictly inside the
 // smallest sphere through the corners, by CGAL's exact test against every
-// point. On a grid every such sphere has points on it (exact fallback); a
-// jitter of 1e-9 leaves near-ties within the filter's margin; a jitter of 0.3
-// lets the floating-point filter decide.
+// point. On a grid many apexes lie exactly on such spheres (the exact
+// fallback decides); a jitter of 1e-9 leaves near-ties within the filter's
+// margin; a jitter of 0.3 lets the floating-point filter decide.
 TEST(Scaffold, GabrielTypesAgreeWithExactDiametralSpheres) {
   using ExactPoint = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
   const auto side_of_bounded_sphere =
