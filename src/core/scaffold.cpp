@@ -127,25 +127,34 @@ struct EdgeVectors {
   double uu, vv, ww;
 };
 
-/// The circumcentre of the triangle with corner a and edge vectors `edges`,
-/// as an offset from a (its length is the circumradius).
-Eigen::Vector3d circumcentreOffset(const EdgeVectors &edges) {
-  return (edges.uu * edges.v.cross(edges.w) + edges.vv * edges.w.cross(edges.u)) / (2.0 * edges.ww);
-}
+/// The circumcentre of a triangle as an offset from its corner a, and the
+/// squared circumradius (the offset's squared length).
+struct CentreOffset {
+  Eigen::Vector3d offset;
+  double radius_squared;
+};
 
-/// The circumcircle of the triangle with corner a and edge vectors `edges`.
+/// The circumcentre of the triangle with corner a and edge vectors `edges`.
 /// None where it does not exist in double precision, though the corners are
 /// not collinear: edge vectors that round to parallel ones (a far corner
 /// beside two close ones), or |u x v|^2 out of range. Callers leave such a
 /// facet out as degenerate.
-std::optional<Circle> circumcircle(const Eigen::Vector3d &a, const EdgeVectors &edges) {
-  Circle circle;
-  const Eigen::Vector3d offset = circumcentreOffset(edges);
-  circle.centre = a + offset;
-  if (!std::isfinite(offset.squaredNorm())) // the radius out of range
+std::optional<CentreOffset> circumcentreOffset(const EdgeVectors &edges) {
+  const Eigen::Vector3d offset =
+      (edges.uu * edges.v.cross(edges.w) + edges.vv * edges.w.cross(edges.u)) / (2.0 * edges.ww);
+  const double radius_squared = offset.squaredNorm();
+  if (!std::isfinite(radius_squared))
     return std::nullopt;
-  circle.unit_normal = edges.w / std::sqrt(edges.ww);
-  return circle;
+  return CentreOffset{offset, radius_squared};
+}
+
+/// The circumcircle of the triangle with corner a and edge vectors `edges`,
+/// where circumcentreOffset() finds its centre.
+std::optional<Circle> circumcircle(const Eigen::Vector3d &a, const EdgeVectors &edges) {
+  const std::optional<CentreOffset> found = circumcentreOffset(edges);
+  if (!found)
+    return std::nullopt;
+  return Circle{a + found->offset, edges.w / std::sqrt(edges.ww)};
 }
 
 // The candidates' pass reads the corner points and scales of the facets, in
@@ -397,11 +406,8 @@ private:
                     kinds.push_back(FacetKind::collinear);
                     return;
                   }
-                  // The circumcircle, as circumcircle() finds it: a squared
-                  // radius out of range is a missing circle.
-                  const Eigen::Vector3d offset = circumcentreOffset(edges);
-                  const double radius_squared = offset.squaredNorm();
-                  if (!std::isfinite(radius_squared)) { // left out like a collinear facet
+                  const std::optional<CentreOffset> circle = circumcentreOffset(edges);
+                  if (!circle) { // left out like a collinear facet
                     kinds.push_back(FacetKind::collinear);
                     return;
                   }
@@ -413,15 +419,15 @@ private:
                                                           min_fast_gabriel_compactness *
                                                           sum_of_squares * sum_of_squares;
                   const bool is_gabriel =
-                      scaffold_.planar ||
-                      isGabriel(delaunay, cell, i, vertices, p + offset, radius_squared, needle);
+                      scaffold_.planar || isGabriel(delaunay, cell, i, vertices, p + circle->offset,
+                                                    circle->radius_squared, needle);
                   if (!is_gabriel) {
                     kinds.push_back(FacetKind::other);
                     return;
                   }
                   gabriel.push_back(
                       {{vertices[0]->info(), vertices[1]->info(), vertices[2]->info()},
-                       static_cast<float>(std::sqrt(radius_squared))});
+                       static_cast<float>(std::sqrt(circle->radius_squared))});
                   kinds.push_back(scaffold_.planar ? FacetKind::gabriel_planar
                                                    : typeGabriel(delaunay, cell, i, sorted,
                                                                  vertices, facets.shock_lengths));
