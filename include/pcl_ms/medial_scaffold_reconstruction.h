@@ -103,7 +103,7 @@ public:
 
   /** \brief Threads for the parallel stages (default 1, 0 = all cores). The
    * mesh does not depend on it. A cloud of fewer than
-   * pcl_ms::Parameters::min_points_for_threads points (30,000) meshed in one
+   * pcl_ms::Parameters::min_points_for_threads points (5,000) meshed in one
    * piece uses one thread: there the threads' start costs more than they save. */
   void setNumberOfThreads(int threads) { parameters_.num_threads = threads; }
   int getNumberOfThreads() const { return parameters_.num_threads; }

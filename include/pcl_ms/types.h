@@ -143,7 +143,7 @@ struct Parameters {
   /// thread whatever num_threads says: below it, starting the threads cost
   /// more than they saved (docs/algorithm.md, "Threads"). 0 = always
   /// num_threads.
-  std::size_t min_points_for_threads = 30000;
+  std::size_t min_points_for_threads = 5000;
   /// Large clouds are meshed in buckets of about this many points that are
   /// stitched together (paper §4). 0 = automatic: buckets of
   /// default_bucket_points above automatic_bucketing_threshold points, one

@@ -223,7 +223,7 @@ TEST(Threads, OneThreadReconstructionDoesNotStartTbb) {
 
 // A cloud meshed in one piece below Parameters::min_points_for_threads runs
 // on one thread whatever num_threads says: on 2 cores, TBB's start cost more
-// than the second thread saved below about 30,000 points.
+// than the second thread saved below about 5,000 points.
 TEST(Threads, SmallCloudDoesNotStartTbb) {
   if (tbbAllocatorLoaded())
     GTEST_SKIP() << "TBB started earlier in this process (run the test alone)";
@@ -231,6 +231,7 @@ TEST(Threads, SmallCloudDoesNotStartTbb) {
   std::vector<float> xyz; // every 8th vertex: about 4,500 points
   for (std::size_t i = 0; i + 3 <= bunny.size(); i += 3 * 8)
     xyz.insert(xyz.end(), bunny.begin() + i, bunny.begin() + i + 3);
+  ASSERT_LT(xyz.size() / 3, Parameters().min_points_for_threads);
   Parameters parameters;
   parameters.num_threads = 2;
   const Result small = reconstruct(pcl_ms_test::viewOf(xyz), parameters);
@@ -252,6 +253,7 @@ TEST(Threads, FewIndexedPointsDoNotStartTbb) {
   std::vector<std::int32_t> every_eighth;
   for (std::size_t i = 0; i < xyz.size() / 3; i += 8)
     every_eighth.push_back(static_cast<std::int32_t>(i));
+  ASSERT_LT(every_eighth.size(), Parameters().min_points_for_threads);
   PointView view = pcl_ms_test::viewOf(xyz);
   view.indices = IndexList(every_eighth);
   Parameters parameters;
