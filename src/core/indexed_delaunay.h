@@ -12,6 +12,7 @@
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Delaunay_triangulation_cell_base_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Spatial_lock_grid_3.h>
 #include <CGAL/Spatial_sort_traits_adapter_3.h>
 #include <CGAL/Triangulation_cell_base_with_info_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
@@ -39,6 +40,19 @@ using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, DataStructure>;
 using CellHandle = Delaunay::Cell_handle;
 using VertexHandle = Delaunay::Vertex_handle;
 using IndexedPoint = std::pair<KernelPoint, VertexIndex>;
+
+/// The same triangulation built by CGAL's parallel insertion, as its
+/// documentation sets it up: concurrent containers and a grid of locks over
+/// the points' bounding box. The grid does not block: a thread that meets a
+/// locked cell gives its point back and retries it later, where a blocking
+/// one would wait on a lock holder that the machine may have descheduled.
+using ParallelDataStructure =
+    CGAL::Triangulation_data_structure_3<VertexBase, CellBase, CGAL::Parallel_tag>;
+using LockGrid = CGAL::Spatial_lock_grid_3<CGAL::Tag_non_blocking>;
+using ParallelDelaunay =
+    CGAL::Delaunay_triangulation_3<Kernel, ParallelDataStructure, CGAL::Default, LockGrid>;
+/// Cells per axis of the lock grid: the value of CGAL's examples.
+inline constexpr int lock_grid_cells_per_axis = 50;
 
 /// (points[i], i) for every i of `chosen` (any range of indices), in that
 /// order: insertIndexed's input.

@@ -7,6 +7,7 @@
 #include <pcl_ms/reconstruct.h>
 #include <pcl_ms/scaffold.h>
 
+#include "corner_order.h"
 #include "flat_cells.h"
 #include "indexed_delaunay.h"
 #include "populate_pages.h"
@@ -20,14 +21,14 @@
 #include <numeric>
 #include <optional>
 
+#include <tbb/info.h>
+
 namespace pcl_ms {
 namespace {
 
-using detail::CellHandle;
 using detail::Delaunay;
 using detail::Kernel;
 using detail::KernelPoint;
-using detail::VertexHandle;
 
 // Cells per unit of parallel work. Chunks are fixed ranges of the cell order,
 // so the output does not depend on how many threads process them.
@@ -48,8 +49,9 @@ constexpr double min_shock_length_fraction = 1e-6;
 Eigen::Vector3d toEigen(const KernelPoint &p) { return {p.x(), p.y(), p.z()}; }
 
 /// The three vertices of facet (cell, i), or false when one is infinite.
-bool facetVertices(const Delaunay &delaunay, CellHandle cell, int i,
-                   std::array<VertexHandle, 3> &vertices) {
+template <typename Triangulation>
+bool facetVertices(const Triangulation &delaunay, typename Triangulation::Cell_handle cell, int i,
+                   std::array<typename Triangulation::Vertex_handle, 3> &vertices) {
   for (int k = 0; k < 3; ++k) {
     vertices[k] = cell->vertex((i + 1 + k) & 3);
     if (delaunay.is_infinite(vertices[k]))
@@ -61,12 +63,14 @@ bool facetVertices(const Delaunay &delaunay, CellHandle cell, int i,
 /// Whether the facet's smallest circumscribing sphere has no Delaunay
 /// neighbour strictly inside, decided with exact predicates: then the
 /// circumcentre lies on the dual Voronoi edge (types I and II).
-bool isGabriel(const Delaunay &delaunay, CellHandle cell, int i,
-               const std::array<VertexHandle, 3> &vertices) {
+template <typename Triangulation>
+bool isGabriel(const Triangulation &delaunay, typename Triangulation::Cell_handle cell, int i,
+               const std::array<typename Triangulation::Vertex_handle, 3> &vertices) {
   const auto side_of_bounded_sphere = Kernel().side_of_bounded_sphere_3_object();
-  const CellHandle neighbour = cell->neighbor(i);
-  const VertexHandle opposite[2] = {cell->vertex(i), neighbour->vertex(neighbour->index(cell))};
-  for (const VertexHandle &apex : opposite) {
+  const auto neighbour = cell->neighbor(i);
+  const typename Triangulation::Vertex_handle opposite[2] = {
+      cell->vertex(i), neighbour->vertex(neighbour->index(cell))};
+  for (const auto &apex : opposite) {
     if (delaunay.is_infinite(apex))
       continue;
     if (side_of_bounded_sphere(vertices[0]->point(), vertices[1]->point(), vertices[2]->point(),
@@ -96,15 +100,17 @@ constexpr double fast_gabriel_margin = 1e-6;
 /// time. `needle`: the facet is less compact than
 /// min_fast_gabriel_compactness. The radius is given squared: most facets
 /// are not Gabriel, and a square root would be waited for in vain.
-bool isGabriel(const Delaunay &delaunay, CellHandle cell, int i,
-               const std::array<VertexHandle, 3> &vertices, const Eigen::Vector3d &centre,
-               double radius_squared, bool needle) {
+template <typename Triangulation>
+bool isGabriel(const Triangulation &delaunay, typename Triangulation::Cell_handle cell, int i,
+               const std::array<typename Triangulation::Vertex_handle, 3> &vertices,
+               const Eigen::Vector3d &centre, double radius_squared, bool needle) {
   if (needle)
     return isGabriel(delaunay, cell, i, vertices);
   const double margin = fast_gabriel_margin * radius_squared;
-  const CellHandle neighbour = cell->neighbor(i);
-  const VertexHandle opposite[2] = {cell->vertex(i), neighbour->vertex(neighbour->index(cell))};
-  for (const VertexHandle &apex : opposite) {
+  const auto neighbour = cell->neighbor(i);
+  const typename Triangulation::Vertex_handle opposite[2] = {
+      cell->vertex(i), neighbour->vertex(neighbour->index(cell))};
+  for (const auto &apex : opposite) {
     if (delaunay.is_infinite(apex))
       continue;
     const KernelPoint &p = apex->point();
@@ -169,6 +175,7 @@ constexpr std::size_t neighbour_prefetch_distance = 8;
 
 // Inlined by force, like every helper that only prefetches: GCC takes such a
 // function for one without effects and drops the calls to it.
+template <typename CellHandle>
 [[gnu::always_inline]] inline void prefetchNeighbours(const std::vector<CellHandle> &cells,
                                                       std::size_t index) {
   if (index >= cells.size())
@@ -207,9 +214,9 @@ double median(std::vector<float> &values) { return medianOf(values.begin(), valu
 
 /// What the local scales' pass finds out about a facet, for the candidates'.
 /// The Gabriel facets of a 3-D triangulation come out typed (acute, obtuse)
-/// with their shock length, or as circleless where their circumcircle does
-/// not exist in double precision from the sorted corners.
-enum class FacetKind : std::uint8_t { collinear, acute, obtuse, circleless, gabriel_planar, other };
+/// with their shock length; a facet whose circumcircle does not exist in
+/// double precision counts as collinear.
+enum class FacetKind : std::uint8_t { collinear, acute, obtuse, gabriel_planar, other };
 
 /// The finite facets of one chunk of cells, in the order visited: what the
 /// candidates' pass reads instead of the triangulation, so that it runs
@@ -220,8 +227,7 @@ struct ChunkFacets {
   std::vector<double> shock_lengths; // one per acute or obtuse facet
 };
 
-/// Whether a facet of this kind was typed: its circle was found from its
-/// corners in ascending order, and its shock length measured.
+/// Whether a facet of this kind was typed: its shock length was measured.
 bool isTyped(FacetKind kind) { return kind == FacetKind::acute || kind == FacetKind::obtuse; }
 
 // |u x v|^2 above this times |u|^2 |v|^2 (a sine above 1e-10) cannot come
@@ -236,8 +242,9 @@ constexpr double surely_signed = 1e-24;
 /// floating-point dot products where their sign is certain, CGAL's exact
 /// test for the rest. a, b, c are the coordinates of the handles' points, in
 /// any order.
+template <typename Handle>
 bool allAnglesAcute(const Eigen::Vector3d &a, const Eigen::Vector3d &b, const Eigen::Vector3d &c,
-                    const std::array<VertexHandle, 3> &handles) {
+                    const std::array<Handle, 3> &handles) {
   const Eigen::Vector3d ab = b - a, bc = c - b, ca = a - c;
   const double ab2 = ab.squaredNorm(), bc2 = bc.squaredNorm(), ca2 = ca.squaredNorm();
   // The angles at a, b and c.
@@ -269,6 +276,12 @@ struct ChunkFates {
   std::size_t counts[5] = {0, 0, 0, 0, 0}; // by FacetFate
 };
 
+/// A Gabriel facet as the local scales read it: corners ascending.
+struct GabrielTriangle {
+  std::array<VertexIndex, 3> corners;
+  float circumradius;
+};
+
 class ScaffoldBuilder {
 public:
   ScaffoldBuilder(const std::vector<Eigen::Vector3d> &points, const ScaffoldOptions &options)
@@ -276,20 +289,24 @@ public:
 
   MedialScaffold build() {
     const auto start = std::chrono::steady_clock::now();
-    Delaunay delaunay = triangulate();
-    scaffold_.delaunay_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-    if (delaunay.dimension() < 2)
-      throw ReconstructionError("all points are collinear: no surface can be built");
-    scaffold_.planar = delaunay.dimension() == 2;
-
-    collectCells(delaunay);
-    measureLocalScales(delaunay);
-    // The facets are listed: the tetrahedra are no longer needed.
-    cells_.clear();
-    cells_.shrink_to_fit();
-    delaunay.clear();
+    if (triangulatesInParallel()) {
+      CGAL::Bbox_3 box;
+      for (const Eigen::Vector3d &point : points_)
+        box += CGAL::Bbox_3(point.x(), point.y(), point.z(), point.x(), point.y(), point.z());
+      detail::LockGrid locks(box, detail::lock_grid_cells_per_axis);
+      detail::ParallelDelaunay delaunay(&locks);
+      {
+        std::vector<detail::IndexedPoint> input = detail::indexedPoints(points_);
+        detail::withThreads(options_.num_threads,
+                            [&] { delaunay.insert(input.begin(), input.end()); });
+      }
+      scaffold_.parallel_triangulation = true;
+      listFacets(delaunay, start);
+    } else {
+      Delaunay delaunay = triangulate();
+      listFacets(delaunay, start);
+    }
+    measureLocalScales();
     buildCandidates();
     chunk_facets_ = {};
     if (options_.fixed_triangles)
@@ -301,6 +318,33 @@ public:
   }
 
 private:
+  /// On several threads the triangulation is built by CGAL's parallel
+  /// insertion: from 6,000 points on (fewer run on one thread) it took
+  /// 0.76-0.84 times the sequential one's time on two (bench/README.md).
+  /// The scaffold does not depend on which one is built.
+  bool triangulatesInParallel() const {
+    const int threads =
+        options_.num_threads > 0 ? options_.num_threads : tbb::info::default_concurrency();
+    return threads > 1;
+  }
+
+  /// Lists the triangulation's facets with what the candidates need of each
+  /// (chunk_facets_) and its Gabriel triangles (chunk_triangles_), then frees the
+  /// tetrahedra. `start`: when the triangulation began.
+  template <typename Triangulation>
+  void listFacets(Triangulation &delaunay, std::chrono::steady_clock::time_point start) {
+    scaffold_.delaunay_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (delaunay.dimension() < 2)
+      throw ReconstructionError("all points are collinear: no surface can be built");
+    scaffold_.planar = delaunay.dimension() == 2;
+    std::vector<typename Triangulation::Cell_handle> cells = collectCells(delaunay);
+    listFacetsOfCells(delaunay, cells);
+    // The facets are listed: the tetrahedra are no longer needed.
+    cells = {};
+    delaunay.clear();
+  }
+
   Delaunay triangulate() const {
     std::vector<detail::IndexedPoint> input = detail::indexedPoints(points_);
     // Inserted in spatial order; symbolic perturbation makes the
@@ -312,27 +356,31 @@ private:
 
   /// Numbers the cells (ids decide which of two cells owns a shared facet)
   /// and lists them in a fixed order for chunked processing.
-  void collectCells(const Delaunay &delaunay) {
+  template <typename Triangulation>
+  std::vector<typename Triangulation::Cell_handle> collectCells(const Triangulation &delaunay) {
+    std::vector<typename Triangulation::Cell_handle> cells;
     if (scaffold_.planar) {
       // In dimension 2 each finite face is stored as a cell of its own.
       for (auto facet = delaunay.finite_facets_begin(); facet != delaunay.finite_facets_end();
            ++facet)
-        cells_.push_back(facet->first);
-      return;
+        cells.push_back(facet->first);
+      return cells;
     }
     std::uint32_t id = 0;
-    cells_.reserve(delaunay.tds().number_of_cells());
-    detail::populateCapacity(cells_);
-    for (CellHandle cell : delaunay.all_cell_handles()) {
+    cells.reserve(delaunay.tds().number_of_cells());
+    detail::populateCapacity(cells);
+    for (auto cell : delaunay.all_cell_handles()) {
       cell->info() = id++;
-      cells_.push_back(cell);
+      cells.push_back(cell);
     }
+    return cells;
   }
 
   /// Calls visit(cell, i, vertices) once for every finite facet owned by cell.
-  template <typename Visit>
-  void forEachOwnedFacet(const Delaunay &delaunay, CellHandle cell, const Visit &visit) const {
-    std::array<VertexHandle, 3> vertices;
+  template <typename Triangulation, typename Visit>
+  void forEachOwnedFacet(const Triangulation &delaunay, typename Triangulation::Cell_handle cell,
+                         const Visit &visit) const {
+    std::array<typename Triangulation::Vertex_handle, 3> vertices;
     if (scaffold_.planar) {
       vertices = {cell->vertex(0), cell->vertex(1), cell->vertex(2)};
       visit(cell, 3, vertices);
@@ -345,6 +393,86 @@ private:
       if (facetVertices(delaunay, cell, i, vertices))
         visit(cell, i, vertices);
     }
+  }
+
+  /// The facet pass: every finite facet once, in chunks of cells, with its
+  /// corners, kind and shock length (chunk_facets_), and the Gabriel ones
+  /// with their circumradii (chunk_triangles_).
+  template <typename Triangulation>
+  void listFacetsOfCells(const Triangulation &delaunay,
+                         const std::vector<typename Triangulation::Cell_handle> &cells) {
+    using VertexHandle = typename Triangulation::Vertex_handle;
+    chunk_triangles_.assign(chunkCount(cells.size()), {});
+    chunk_facets_.assign(chunkCount(cells.size()), {});
+    forEachChunk(
+        cells.size(), options_.num_threads,
+        [&](std::size_t chunk, std::size_t begin, std::size_t end) {
+          // Filled with room for every facet the cells can own (4 a cell, 1
+          // in a plane), then kept at their exact sizes: grown by doubling,
+          // the lists' copies took a sixth of a call's page faults
+          // (bench/README.md, "Pages faulted in before the first write").
+          const std::size_t most_facets = (scaffold_.planar ? 1 : 4) * (end - begin);
+          ChunkFacets facets;
+          std::vector<GabrielTriangle> gabriel;
+          facets.corners.reserve(most_facets);
+          facets.kinds.reserve(most_facets);
+          facets.shock_lengths.reserve(most_facets);
+          gabriel.reserve(most_facets);
+          std::vector<FacetKind> &kinds = facets.kinds;
+          for (std::size_t index = begin; index < end; ++index) {
+            if (!scaffold_.planar)
+              prefetchNeighbours(cells, index + neighbour_prefetch_distance);
+            forEachOwnedFacet(delaunay, cells[index], [&](auto cell, int i, const auto &vertices) {
+              // Everything below is computed from the corners in
+              // ascending order, so the candidates do not depend on the
+              // order in which the triangulation stores cells and their
+              // vertices (docs/algorithm.md, "Candidate order").
+              const std::array<VertexHandle, 3> ordered = detail::byIndex(vertices);
+              const Triangle sorted = {ordered[0]->info(), ordered[1]->info(), ordered[2]->info()};
+              facets.corners.push_back(sorted);
+              const Eigen::Vector3d a = toEigen(ordered[0]->point()),
+                                    b = toEigen(ordered[1]->point()),
+                                    c = toEigen(ordered[2]->point());
+              const EdgeVectors edges(a, b, c);
+              if (!(edges.ww > surely_not_collinear * edges.uu * edges.vv) &&
+                  CGAL::collinear(ordered[0]->point(), ordered[1]->point(), ordered[2]->point())) {
+                kinds.push_back(FacetKind::collinear);
+                return;
+              }
+              const std::optional<CentreOffset> circle = circumcentreOffset(edges);
+              if (!circle) { // left out like a collinear facet
+                kinds.push_back(FacetKind::collinear);
+                return;
+              }
+              // Compactness 4 sqrt(3) A / (d1^2 + d2^2 + d3^2), A = |w| / 2,
+              // compared squared: no root, no division.
+              const double sum_of_squares = edges.uu + edges.vv + (edges.v - edges.u).squaredNorm();
+              const bool needle = 12 * edges.ww < min_fast_gabriel_compactness *
+                                                      min_fast_gabriel_compactness *
+                                                      sum_of_squares * sum_of_squares;
+              const Eigen::Vector3d centre = a + circle->offset;
+              const bool is_gabriel =
+                  scaffold_.planar ||
+                  isGabriel(delaunay, cell, i, ordered, centre, circle->radius_squared, needle);
+              if (!is_gabriel) {
+                kinds.push_back(FacetKind::other);
+                return;
+              }
+              gabriel.push_back({sorted, static_cast<float>(std::sqrt(circle->radius_squared))});
+              if (scaffold_.planar) {
+                kinds.push_back(FacetKind::gabriel_planar);
+                return;
+              }
+              facets.shock_lengths.push_back(
+                  shockLength(delaunay, cell, i, Circle{centre, edges.w / std::sqrt(edges.ww)}));
+              kinds.push_back(allAnglesAcute(a, b, c, ordered) ? FacetKind::acute
+                                                               : FacetKind::obtuse);
+            });
+          }
+          chunk_facets_[chunk] = {detail::exactCopy(facets.corners), detail::exactCopy(kinds),
+                                  detail::exactCopy(facets.shock_lengths)};
+          chunk_triangles_[chunk] = detail::exactCopy(gabriel);
+        });
   }
 
   /// Each point's local scale (docs/algorithm.md, "Local scale"): the
@@ -366,77 +494,9 @@ private:
   /// 3. One factor for the whole cloud makes the median scale the median
   ///    Gabriel circumradius, d_med: on a uniform sample every scale is about
   ///    d_med, and rho keeps the meaning it had with one global length.
-  void measureLocalScales(const Delaunay &delaunay) {
+  void measureLocalScales() {
     const std::size_t n = points_.size();
-    struct GabrielTriangle {
-      std::array<VertexIndex, 3> corners;
-      float circumradius;
-    };
-    std::vector<std::vector<GabrielTriangle>> chunk_triangles(chunkCount(cells_.size()));
-    chunk_facets_.assign(chunkCount(cells_.size()), {});
-    forEachChunk(
-        cells_.size(), options_.num_threads,
-        [&](std::size_t chunk, std::size_t begin, std::size_t end) {
-          // Filled with room for every facet the cells can own (4 a cell, 1
-          // in a plane), then kept at their exact sizes: grown by doubling,
-          // the lists' copies took a sixth of a call's page faults
-          // (bench/README.md, "Pages faulted in before the first write").
-          const std::size_t most_facets = (scaffold_.planar ? 1 : 4) * (end - begin);
-          ChunkFacets facets;
-          std::vector<GabrielTriangle> gabriel;
-          facets.corners.reserve(most_facets);
-          facets.kinds.reserve(most_facets);
-          facets.shock_lengths.reserve(most_facets);
-          gabriel.reserve(most_facets);
-          std::vector<FacetKind> &kinds = facets.kinds;
-          for (std::size_t index = begin; index < end; ++index) {
-            if (!scaffold_.planar)
-              prefetchNeighbours(cells_, index + neighbour_prefetch_distance);
-            forEachOwnedFacet(
-                delaunay, cells_[index], [&](CellHandle cell, int i, const auto &vertices) {
-                  Triangle sorted = {vertices[0]->info(), vertices[1]->info(), vertices[2]->info()};
-                  std::sort(sorted.begin(), sorted.end());
-                  facets.corners.push_back(sorted);
-                  const KernelPoint &a = vertices[0]->point(), &b = vertices[1]->point(),
-                                    &c = vertices[2]->point();
-                  const Eigen::Vector3d p = toEigen(a);
-                  const EdgeVectors edges(p, toEigen(b), toEigen(c));
-                  if (!(edges.ww > surely_not_collinear * edges.uu * edges.vv) &&
-                      CGAL::collinear(a, b, c)) {
-                    kinds.push_back(FacetKind::collinear);
-                    return;
-                  }
-                  const std::optional<CentreOffset> circle = circumcentreOffset(edges);
-                  if (!circle) { // left out like a collinear facet
-                    kinds.push_back(FacetKind::collinear);
-                    return;
-                  }
-                  // Compactness 4 sqrt(3) A / (d1^2 + d2^2 + d3^2), A = |w| / 2,
-                  // compared squared: no root, no division.
-                  const double sum_of_squares =
-                      edges.uu + edges.vv + (edges.v - edges.u).squaredNorm();
-                  const bool needle = 12 * edges.ww < min_fast_gabriel_compactness *
-                                                          min_fast_gabriel_compactness *
-                                                          sum_of_squares * sum_of_squares;
-                  const bool is_gabriel =
-                      scaffold_.planar || isGabriel(delaunay, cell, i, vertices, p + circle->offset,
-                                                    circle->radius_squared, needle);
-                  if (!is_gabriel) {
-                    kinds.push_back(FacetKind::other);
-                    return;
-                  }
-                  gabriel.push_back(
-                      {{vertices[0]->info(), vertices[1]->info(), vertices[2]->info()},
-                       static_cast<float>(std::sqrt(circle->radius_squared))});
-                  kinds.push_back(scaffold_.planar ? FacetKind::gabriel_planar
-                                                   : typeGabriel(delaunay, cell, i, sorted,
-                                                                 vertices, facets.shock_lengths));
-                });
-          }
-          chunk_facets_[chunk] = {detail::exactCopy(facets.corners), detail::exactCopy(kinds),
-                                  detail::exactCopy(facets.shock_lengths)};
-          chunk_triangles[chunk] = detail::exactCopy(gabriel);
-        });
+    std::vector<std::vector<GabrielTriangle>> chunk_triangles = std::move(chunk_triangles_);
     // Each point's Gabriel triangles (CSR): their circumradii and, two per
     // triangle, the other corners.
     std::vector<std::uint32_t> offsets(n + 1, 0);
@@ -496,7 +556,9 @@ private:
         by_size.clear();
         for (std::uint32_t slot = offsets[v]; slot < offsets[v + 1]; ++slot)
           by_size.emplace_back(radii_at[slot], slot);
-        std::sort(by_size.begin(), by_size.end());
+        std::sort(by_size.begin(), by_size.end(), [&](const auto &x, const auto &y) {
+          return x.first != y.first ? x.first < y.first : cornersOf(x.second) < cornersOf(y.second);
+        });
         double covered = 0;
         for (const auto &[radius, slot] : by_size) {
           own[v] = radius;
@@ -571,25 +633,12 @@ private:
     }
   }
 
-  /// The type of a Gabriel facet of a 3-D triangulation, appending its shock
-  /// length to `shock_lengths` where it has one. Its circle is computed again
-  /// from the corners in ascending order, as its cost is: from other corners
-  /// than the Gabriel test's, it may be missing where that one's was found.
-  FacetKind typeGabriel(const Delaunay &delaunay, CellHandle cell, int i, const Triangle &sorted,
-                        const std::array<VertexHandle, 3> &handles,
-                        std::vector<double> &shock_lengths) const {
-    const Eigen::Vector3d &a = points_[sorted[0]], &b = points_[sorted[1]], &c = points_[sorted[2]];
-    const std::optional<Circle> found = circumcircle(a, EdgeVectors(a, b, c));
-    if (!found)
-      return FacetKind::circleless;
-    shock_lengths.push_back(shockLength(delaunay, cell, i, *found));
-    return allAnglesAcute(a, b, c, handles) ? FacetKind::acute : FacetKind::obtuse;
-  }
-
   /// The shorter piece of the dual Voronoi edge cut by the circumcentre.
-  double shockLength(const Delaunay &delaunay, CellHandle cell, int i, const Circle &circle) const {
+  template <typename Triangulation>
+  double shockLength(const Triangulation &delaunay, typename Triangulation::Cell_handle cell, int i,
+                     const Circle &circle) const {
     double shortest = std::numeric_limits<double>::infinity();
-    for (CellHandle side : {cell, cell->neighbor(i)}) {
+    for (const auto side : {cell, cell->neighbor(i)}) {
       Eigen::Vector3d voronoi_vertex;
       if (delaunay.is_infinite(side) || !detail::circumcentre(side, voronoi_vertex.data()))
         continue; // that piece is a ray (or as long as one): infinitely long
@@ -627,7 +676,7 @@ private:
     // counts those whose lowest corner is v - 1, then, summed, is where the
     // next one whose lowest corner is v goes.
     const std::size_t n = points_.size();
-    std::vector<std::uint32_t> next_gabriel(n + 1, 0);
+    std::vector<std::uint32_t> next_gabriel(n + 1, 0), next_ambiguous(n + 1, 0);
     std::vector<ChunkFates> chunks(chunk_facets_.size());
     forEachFacetChunk([&](std::size_t chunk) {
       const ChunkFacets &facets = chunk_facets_[chunk];
@@ -640,13 +689,12 @@ private:
         ++out.counts[static_cast<int>(fate)];
         if (fate == FacetFate::gabriel)
           detail::countUp(next_gabriel[facets.corners[f][0] + 1]);
+        else if (fate == FacetFate::ambiguous)
+          detail::countUp(next_ambiguous[facets.corners[f][0] + 1]);
       }
     });
-    // Where each chunk's type III candidates start.
-    std::vector<std::size_t> ambiguous_start(chunks.size());
     std::size_t gabriel_total = 0, ambiguous_total = 0;
     for (std::size_t chunk = 0; chunk < chunks.size(); ++chunk) {
-      ambiguous_start[chunk] = ambiguous_total;
       gabriel_total += chunks[chunk].counts[static_cast<int>(FacetFate::gabriel)];
       ambiguous_total += chunks[chunk].counts[static_cast<int>(FacetFate::ambiguous)];
       scaffold_.oversize += chunks[chunk].counts[static_cast<int>(FacetFate::oversize)];
@@ -655,11 +703,12 @@ private:
     std::vector<Candidate> &candidates = scaffold_.candidates;
     detail::resizeForWriting(candidates, gabriel_total + ambiguous_total);
     std::partial_sum(next_gabriel.begin(), next_gabriel.end(), next_gabriel.begin());
+    next_ambiguous[0] = static_cast<std::uint32_t>(gabriel_total);
+    std::partial_sum(next_ambiguous.begin(), next_ambiguous.end(), next_ambiguous.begin());
     std::vector<std::array<std::size_t, 4>> type_counts(chunks.size(), {0, 0, 0, 0});
     forEachFacetChunk([&](std::size_t chunk) {
       const ChunkFacets &facets = chunk_facets_[chunk];
       const std::vector<FacetFate> &fates = chunks[chunk].fates;
-      std::size_t next_ambiguous = gabriel_total + ambiguous_start[chunk];
       std::vector<double>::const_iterator next_shock_length = facets.shock_lengths.begin();
       for (std::size_t f = 0; f < fates.size(); ++f) {
         const FacetKind kind = facets.kinds[f];
@@ -670,9 +719,8 @@ private:
         // Chunks on other threads may share a lowest corner: the slot is
         // taken atomically, and the order it gives is undone by the sort
         // below.
-        Candidate &candidate = candidates[fates[f] == FacetFate::gabriel
-                                              ? detail::countUp(next_gabriel[facets.corners[f][0]])
-                                              : next_ambiguous++];
+        Candidate &candidate = candidates[detail::countUp((
+            fates[f] == FacetFate::gabriel ? next_gabriel : next_ambiguous)[facets.corners[f][0]])];
         cost(facets.corners[f], kind, measured_shock_length, candidate);
         ++type_counts[chunk][static_cast<int>(candidate.type)];
       }
@@ -681,10 +729,15 @@ private:
     // next smaller corner's end is where they begin: the few of each corner
     // are sorted by their other two.
     forEachChunk(n, options_.num_threads, [&](std::size_t, std::size_t begin, std::size_t end) {
-      for (std::size_t v = begin; v < end; ++v)
+      auto byCorners = [](const Candidate &a, const Candidate &b) {
+        return a.vertices < b.vertices;
+      };
+      for (std::size_t v = begin; v < end; ++v) {
         std::sort(candidates.begin() + (v > 0 ? next_gabriel[v - 1] : 0),
-                  candidates.begin() + next_gabriel[v],
-                  [](const Candidate &a, const Candidate &b) { return a.vertices < b.vertices; });
+                  candidates.begin() + next_gabriel[v], byCorners);
+        std::sort(candidates.begin() + (v > 0 ? next_ambiguous[v - 1] : gabriel_total),
+                  candidates.begin() + next_ambiguous[v], byCorners);
+      }
     });
     for (const auto &counts : type_counts) {
       scaffold_.type1 += counts[1];
@@ -720,7 +773,7 @@ private:
     if (std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()}) >=
         max_side * max_side)
       return FacetFate::oversize;
-    if (kind == FacetKind::collinear || kind == FacetKind::circleless)
+    if (kind == FacetKind::collinear)
       return FacetFate::degenerate;
     // The normal term needs the circle's normal (a typed facet's was found).
     if (options_.normals && !isTyped(kind) && !circumcircle(a, EdgeVectors(a, b, c)))
@@ -939,10 +992,10 @@ private:
   const std::vector<Eigen::Vector3d> &points_;
   const ScaffoldOptions &options_;
   MedialScaffold scaffold_;
-  std::vector<CellHandle> cells_;
-  /// Per chunk of cells, its facets as the local scales' pass found them,
-  /// for the candidates' pass.
+  /// Per chunk of cells, its facets as the facet pass found them, for the
+  /// candidates' pass, and its Gabriel triangles, for the local scales.
   std::vector<ChunkFacets> chunk_facets_;
+  std::vector<std::vector<GabrielTriangle>> chunk_triangles_;
 };
 
 } // namespace

@@ -86,19 +86,21 @@ private:
   HandOff start_, fed_, done_;
 };
 
-/// Adds one to a count that other threads may add to as well, and returns
-/// the count before. For counts and slots taken from parallel loops: the
-/// order the slots are taken in depends on the threads, so callers sort what
-/// they put in them.
-template <typename Count> Count countUp(Count &count) {
-  return __atomic_fetch_add(&count, Count{1}, __ATOMIC_RELAXED);
-}
-
 /// Whether the calling thread runs work limited to one thread (see
 /// withThreads): the loops below then run on it, in order.
 inline bool &onOneThread() {
   thread_local bool one_thread = false;
   return one_thread;
+}
+
+/// Adds one to a count that other threads may add to as well, and returns
+/// the count before. For counts and slots taken from parallel loops: the
+/// order the slots are taken in depends on the threads, so callers sort what
+/// they put in them. On one thread no other thread can add: a plain addition.
+template <typename Count> Count countUp(Count &count) {
+  if (onOneThread())
+    return count++;
+  return __atomic_fetch_add(&count, Count{1}, __ATOMIC_RELAXED);
 }
 
 /// Runs work() with at most num_threads threads for the loops below, or

@@ -3,6 +3,7 @@
 #include "core_test_support.h"
 #include "fan_choice.h"
 #include "finish_steps.h"
+#include "flat_cells.h"
 #include "threads.h"
 
 #include <pcl_ms/costs.h>
@@ -14,6 +15,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <random>
 #include <set>
@@ -221,31 +223,98 @@ TEST(Scaffold, EdgeGraphHoldsOnlyTheCandidatesOfPassOne) {
 }
 
 // Types I and II come first, in the order of their corners (what keeps
-// neighbours on the surface close in memory), type III after them; the
-// list is the same for any thread count, though the slots are taken by
-// several threads at once.
-TEST(Scaffold, GabrielCandidatesComeFirstInTheirCornersOrderOnAnyThreadCount) {
+// neighbours on the surface close in memory), type III after them, in the
+// order of their corners too. The list is the same for any thread count:
+// on two threads CGAL's parallel insertion builds the triangulation, whose
+// cells and their corners are stored in another order, and several threads
+// take the slots at once.
+TEST(Scaffold, CandidatesComeInTheirCornersOrderFromEitherTriangulation) {
   const std::vector<Eigen::Vector3d> points = pcl_ms_test::bunnyReference().vertices;
   ScaffoldOptions one_thread, two_threads;
   two_threads.num_threads = 2;
   const MedialScaffold scaffold = buildMedialScaffold(points, one_thread);
+  EXPECT_FALSE(scaffold.parallel_triangulation);
   const std::vector<Candidate> &candidates = scaffold.candidates;
   const std::size_t gabriel = scaffold.type1 + scaffold.type2;
   ASSERT_GT(gabriel, 10000u);
-  ASSERT_GT(scaffold.type3, 0u);
+  ASSERT_GT(scaffold.type3, 10000u);
   ASSERT_EQ(candidates.size(), gabriel + scaffold.type3);
   for (std::size_t t = 0; t < candidates.size(); ++t)
     ASSERT_EQ(candidates[t].type == CandidateType::ambiguous, t >= gabriel) << t;
-  for (std::size_t t = 1; t < gabriel; ++t)
+  for (std::size_t t = 1; t < candidates.size(); ++t) {
+    if (t == gabriel) // each group ascends on its own
+      continue;
     ASSERT_LT(candidates[t - 1].vertices, candidates[t].vertices) << t;
+  }
 
   const MedialScaffold again = buildMedialScaffold(points, two_threads);
+  EXPECT_TRUE(again.parallel_triangulation);
   ASSERT_EQ(again.candidates.size(), candidates.size());
   for (std::size_t t = 0; t < candidates.size(); ++t) {
     ASSERT_EQ(again.candidates[t].vertices, candidates[t].vertices) << t;
+    ASSERT_EQ(again.candidates[t].type, candidates[t].type) << t;
     ASSERT_EQ(again.candidates[t].base_cost, candidates[t].base_cost) << t;
+    ASSERT_EQ(again.candidates[t].inverse_shock_compactness,
+              candidates[t].inverse_shock_compactness)
+        << t;
     ASSERT_EQ(again.candidates[t].edges, candidates[t].edges) << t;
   }
+  EXPECT_EQ(again.local_scale, scaffold.local_scale);
+  EXPECT_EQ(again.d_med, scaffold.d_med);
+  EXPECT_EQ(again.oversize, scaffold.oversize);
+  EXPECT_EQ(again.degenerate, scaffold.degenerate);
+}
+
+namespace {
+
+/// Just what detail::circumcentre reads of a triangulation's cell: its
+/// corners' points and indices, here in any order.
+struct CornerStub {
+  CGAL::Epick::Point_3 position;
+  std::uint32_t index;
+  const CGAL::Epick::Point_3 &point() const { return position; }
+  std::uint32_t info() const { return index; }
+};
+struct CellStub {
+  std::array<const CornerStub *, 4> corners;
+  const CornerStub *vertex(int k) const { return corners[static_cast<std::size_t>(k)]; }
+};
+
+} // namespace
+
+// A Voronoi vertex (the shock lengths' ends) comes out bit for bit the same
+// whatever order a cell stores its corners in: the two triangulations
+// store them differently.
+TEST(Scaffold, CircumcentreDoesNotDependOnTheCornersOrder) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+  int orders_that_moved_the_plain_formula = 0;
+  for (int cell = 0; cell < 200; ++cell) {
+    std::array<CornerStub, 4> corners;
+    for (std::uint32_t k = 0; k < 4; ++k)
+      corners[k] = {{coordinate(random), coordinate(random), coordinate(random)}, 10 * k + 3};
+    std::array<int, 4> order = {0, 1, 2, 3};
+    CellStub stub{{&corners[0], &corners[1], &corners[2], &corners[3]}};
+    double first[3];
+    ASSERT_TRUE(detail::circumcentre(&stub, first));
+    const CGAL::Epick::Point_3 plain = CGAL::circumcenter(corners[0].position, corners[1].position,
+                                                          corners[2].position, corners[3].position);
+    while (std::next_permutation(order.begin(), order.end())) {
+      for (int k = 0; k < 4; ++k)
+        stub.corners[static_cast<std::size_t>(k)] = &corners[static_cast<std::size_t>(order[k])];
+      double centre[3];
+      ASSERT_TRUE(detail::circumcentre(&stub, centre));
+      for (int axis = 0; axis < 3; ++axis)
+        ASSERT_EQ(centre[axis], first[axis]) << cell;
+      const CGAL::Epick::Point_3 permuted =
+          CGAL::circumcenter(stub.corners[0]->position, stub.corners[1]->position,
+                             stub.corners[2]->position, stub.corners[3]->position);
+      orders_that_moved_the_plain_formula += permuted != plain;
+    }
+  }
+  // Without the ordering the last bits would move: CGAL's own construction
+  // does, on the same cells.
+  EXPECT_GT(orders_that_moved_the_plain_formula, 100);
 }
 
 TEST(Scaffold, ObtuseGabrielTriangleIsTypeTwo) {

@@ -4,14 +4,13 @@
 #include "core_test_support.h"
 #include "threads.h"
 
-#include <link.h>
-
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
-#include <cstring>
+#include <fstream>
 #include <functional>
 #include <numeric>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -19,17 +18,19 @@ using namespace pcl_ms;
 
 namespace {
 
-/// Whether TBB's allocator library is loaded: TBB loads it when it starts.
-bool tbbAllocatorLoaded() {
-  bool loaded = false;
-  dl_iterate_phdr(
-      [](dl_phdr_info *info, std::size_t, void *found) {
-        if (info->dlpi_name && std::strstr(info->dlpi_name, "libtbbmalloc"))
-          *static_cast<bool *>(found) = true;
-        return 0;
-      },
-      &loaded);
-  return loaded;
+/// Whether TBB has started: it starts worker threads when it first runs
+/// work on more than one thread, and keeps them, and the test process has
+/// no thread of its own besides the main one. (Whether TBB's allocator
+/// library is loaded told it too until the core linked that library for
+/// CGAL's parallel triangulation.)
+bool tbbStarted() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line))
+    if (line.rfind("Threads:", 0) == 0)
+      return std::stoul(line.substr(8)) > 1;
+  ADD_FAILURE() << "no thread count in /proc/self/status";
+  return true;
 }
 
 /// Every n-th vertex of the bunny, as coordinates.
@@ -48,9 +49,9 @@ void expectTbbStartsOnlyWith(const std::vector<float> &xyz, const Parameters &wi
                              const Parameters &with, std::size_t min_triangles) {
   const Result first = reconstruct(pcl_ms_test::viewOf(xyz), without);
   EXPECT_GT(first.triangles.size(), min_triangles);
-  EXPECT_FALSE(tbbAllocatorLoaded());
+  EXPECT_FALSE(tbbStarted());
   const Result second = reconstruct(pcl_ms_test::viewOf(xyz), with);
-  EXPECT_TRUE(tbbAllocatorLoaded());
+  EXPECT_TRUE(tbbStarted());
   EXPECT_EQ(second.triangles, first.triangles);
 }
 
@@ -222,7 +223,7 @@ TEST(Threads, TaskWritesAreOrderedBeforeTheCallerAfterTheLoop) {
 // one-thread reconstruction must not start it. ctest runs each test in its
 // own process, where TBB has not started before.
 TEST(Threads, OneThreadReconstructionDoesNotStartTbb) {
-  if (tbbAllocatorLoaded())
+  if (tbbStarted())
     GTEST_SKIP() << "TBB started earlier in this process (run the test alone)";
   const std::vector<float> xyz = pcl_ms_test::bunnyCoordinates();
   Parameters parameters;
@@ -233,21 +234,21 @@ TEST(Threads, OneThreadReconstructionDoesNotStartTbb) {
   const Result bucketed = reconstruct(pcl_ms_test::viewOf(xyz), parameters);
   EXPECT_GT(bucketed.bucket_statistics.buckets, 1u);
   EXPECT_GT(bucketed.triangles.size(), 60000u);
-  EXPECT_FALSE(tbbAllocatorLoaded());
+  EXPECT_FALSE(tbbStarted());
   // The check sees TBB when it does start.
   std::atomic<int> done{0};
   detail::withThreads(2, [&] {
     detail::parallelFor(std::size_t(0), std::size_t(1000), [&](std::size_t) { ++done; });
   });
   EXPECT_EQ(done.load(), 1000);
-  EXPECT_TRUE(tbbAllocatorLoaded());
+  EXPECT_TRUE(tbbStarted());
 }
 
 // A cloud meshed in one piece below Parameters::min_points_for_threads runs
 // on one thread whatever num_threads says: on 2 cores, TBB's start cost more
 // than the second thread saved below about 5,000 points.
 TEST(Threads, SmallCloudDoesNotStartTbb) {
-  if (tbbAllocatorLoaded())
+  if (tbbStarted())
     GTEST_SKIP() << "TBB started earlier in this process (run the test alone)";
   const std::vector<float> xyz = everyNthBunnyVertex(8); // about 4,500 points
   ASSERT_LT(xyz.size() / 3, Parameters().min_points_for_threads);
@@ -262,7 +263,7 @@ TEST(Threads, SmallCloudDoesNotStartTbb) {
 // 2 cores they saved 3-14 % from 6,000 points on (docs/algorithm.md,
 // "Threads"). The mesh is the one-thread mesh.
 TEST(Threads, CloudAtTheThresholdStartsTbb) {
-  if (tbbAllocatorLoaded())
+  if (tbbStarted())
     GTEST_SKIP() << "TBB started earlier in this process (run the test alone)";
   const std::vector<float> xyz = everyNthBunnyVertex(4); // about 9,000 points
   ASSERT_GE(xyz.size() / 3, Parameters().min_points_for_threads);
@@ -276,7 +277,7 @@ TEST(Threads, CloudAtTheThresholdStartsTbb) {
 // The preparation counts the points the indices select, not the whole
 // cloud: 4,500 of the bunny's 35,947 vertices are a small cloud too.
 TEST(Threads, FewIndexedPointsDoNotStartTbb) {
-  if (tbbAllocatorLoaded())
+  if (tbbStarted())
     GTEST_SKIP() << "TBB started earlier in this process (run the test alone)";
   const std::vector<float> xyz = pcl_ms_test::bunnyCoordinates();
   ASSERT_GE(xyz.size() / 3, Parameters().min_points_for_threads);
@@ -290,5 +291,5 @@ TEST(Threads, FewIndexedPointsDoNotStartTbb) {
   parameters.num_threads = 2;
   const Result small = reconstruct(view, parameters);
   EXPECT_GT(small.triangles.size(), 7000u);
-  EXPECT_FALSE(tbbAllocatorLoaded());
+  EXPECT_FALSE(tbbStarted());
 }

@@ -79,6 +79,9 @@ struct MedialScaffold {
   std::size_t oversize = 0;   // longest side >= rho * local scale: never queued
   std::size_t degenerate = 0; // collinear generators: never queued
   double delaunay_seconds = 0;
+  /// Whether CGAL's parallel insertion built the triangulation (on several
+  /// threads); the scaffold is the same either way.
+  bool parallel_triangulation = false;
 
   std::size_t numberOfEdges() const { return edge_offsets.empty() ? 0 : edge_offsets.size() - 1; }
   /// Candidates on edge e, as a [begin, end) pointer range.
