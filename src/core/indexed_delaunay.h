@@ -9,6 +9,7 @@
 #include "huge_page_allocator.h"
 #include "populate_pages.h"
 
+#include <CGAL/Bbox_3.h>
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Delaunay_triangulation_cell_base_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -53,6 +54,31 @@ using ParallelDelaunay =
     CGAL::Delaunay_triangulation_3<Kernel, ParallelDataStructure, CGAL::Default, LockGrid>;
 /// Cells per axis of the lock grid: the value of CGAL's examples.
 inline constexpr int lock_grid_cells_per_axis = 50;
+
+/// The smallest box holding every point: what the lock grid covers.
+inline CGAL::Bbox_3 boundingBox(const std::vector<Eigen::Vector3d> &points) {
+  CGAL::Bbox_3 box;
+  for (const Eigen::Vector3d &point : points)
+    box += CGAL::Bbox_3(point.x(), point.y(), point.z(), point.x(), point.y(), point.z());
+  return box;
+}
+
+/// A triangulation for CGAL's parallel insertion together with the lock grid
+/// over the points' bounding box that it needs and must not outlive.
+struct ParallelTriangulation {
+  explicit ParallelTriangulation(const std::vector<Eigen::Vector3d> &points)
+      : locks(boundingBox(points), lock_grid_cells_per_axis), delaunay(&locks) {}
+  ParallelTriangulation(const ParallelTriangulation &) = delete;
+  ParallelTriangulation &operator=(const ParallelTriangulation &) = delete;
+
+  /// Inserts `input` with CGAL's range insertion, which sorts it spatially
+  /// and shares it among the threads of the calling task arena (withThreads).
+  /// Reorders `input`.
+  void insert(std::vector<IndexedPoint> &input) { delaunay.insert(input.begin(), input.end()); }
+
+  LockGrid locks; // declared first: built before the triangulation, freed after it
+  ParallelDelaunay delaunay;
+};
 
 /// (points[i], i) for every i of `chosen` (any range of indices), in that
 /// order: insertIndexed's input.

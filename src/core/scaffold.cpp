@@ -154,13 +154,19 @@ std::optional<CentreOffset> circumcentreOffset(const EdgeVectors &edges) {
   return CentreOffset{offset, radius_squared};
 }
 
+/// The circumcircle of the triangle with corner a, edge vectors `edges` and
+/// circumcentre a + `found`.
+Circle circleAt(const Eigen::Vector3d &a, const EdgeVectors &edges, const CentreOffset &found) {
+  return Circle{a + found.offset, edges.w / std::sqrt(edges.ww)};
+}
+
 /// The circumcircle of the triangle with corner a and edge vectors `edges`,
 /// where circumcentreOffset() finds its centre.
 std::optional<Circle> circumcircle(const Eigen::Vector3d &a, const EdgeVectors &edges) {
   const std::optional<CentreOffset> found = circumcentreOffset(edges);
   if (!found)
     return std::nullopt;
-  return Circle{a + found->offset, edges.w / std::sqrt(edges.ww)};
+  return circleAt(a, edges, *found);
 }
 
 // The candidates' pass reads the corner points and scales of the facets, in
@@ -290,18 +296,13 @@ public:
   MedialScaffold build() {
     const auto start = std::chrono::steady_clock::now();
     if (triangulatesInParallel()) {
-      CGAL::Bbox_3 box;
-      for (const Eigen::Vector3d &point : points_)
-        box += CGAL::Bbox_3(point.x(), point.y(), point.z(), point.x(), point.y(), point.z());
-      detail::LockGrid locks(box, detail::lock_grid_cells_per_axis);
-      detail::ParallelDelaunay delaunay(&locks);
+      detail::ParallelTriangulation parallel(points_);
       {
         std::vector<detail::IndexedPoint> input = detail::indexedPoints(points_);
-        detail::withThreads(options_.num_threads,
-                            [&] { delaunay.insert(input.begin(), input.end()); });
+        detail::withThreads(options_.num_threads, [&] { parallel.insert(input); });
       }
       scaffold_.parallel_triangulation = true;
-      listFacets(delaunay, start);
+      listFacets(parallel.delaunay, start);
     } else {
       Delaunay delaunay = triangulate();
       listFacets(delaunay, start);
@@ -450,10 +451,9 @@ private:
               const bool needle = 12 * edges.ww < min_fast_gabriel_compactness *
                                                       min_fast_gabriel_compactness *
                                                       sum_of_squares * sum_of_squares;
-              const Eigen::Vector3d centre = a + circle->offset;
               const bool is_gabriel =
-                  scaffold_.planar ||
-                  isGabriel(delaunay, cell, i, ordered, centre, circle->radius_squared, needle);
+                  scaffold_.planar || isGabriel(delaunay, cell, i, ordered, a + circle->offset,
+                                                circle->radius_squared, needle);
               if (!is_gabriel) {
                 kinds.push_back(FacetKind::other);
                 return;
@@ -464,7 +464,7 @@ private:
                 return;
               }
               facets.shock_lengths.push_back(
-                  shockLength(delaunay, cell, i, Circle{centre, edges.w / std::sqrt(edges.ww)}));
+                  shockLength(delaunay, cell, i, circleAt(a, edges, *circle)));
               kinds.push_back(allAnglesAcute(a, b, c, ordered) ? FacetKind::acute
                                                                : FacetKind::obtuse);
             });
