@@ -8,8 +8,8 @@
 # mesh their own buckets and seam zones and finish the surface in parts;
 # rank 0 writes the runs as the ranks send them), and whether every
 # mesh is byte-identical to the single-process one. Not part of ctest: 10M
-# points take about 12 minutes on two cores. -work DIR keeps the cloud and
-# each run's log there.
+# points take about 6 minutes on two cores. -work DIR (created if missing)
+# keeps the cloud and each run's log there.
 #
 # Usage: bench/mpi_scaling.sh [-build DIR] [-points N] [-ranks "1 2 4"]
 #                             [-bucket_points M] [-work DIR] [-mesh PATH]
@@ -33,6 +33,8 @@ done
 if [[ -z $work ]]; then
   work=$(mktemp -d)
   trap 'rm -rf "$work"' EXIT
+else
+  mkdir -p "$work"
 fi
 mpirun_flags=(--oversubscribe)
 [[ $(id -u) == 0 ]] && mpirun_flags+=(--allow-run-as-root)
