@@ -71,10 +71,12 @@ struct ParallelTriangulation {
   ParallelTriangulation(const ParallelTriangulation &) = delete;
   ParallelTriangulation &operator=(const ParallelTriangulation &) = delete;
 
-  /// Inserts `input` with CGAL's range insertion, which sorts it spatially
-  /// and shares it among the threads of the calling task arena (withThreads).
-  /// Reorders `input`.
-  void insert(std::vector<IndexedPoint> &input) { delaunay.insert(input.begin(), input.end()); }
+  /// Inserts `input` with CGAL's range insertion, which sorts indices into a
+  /// copy of the points spatially and shares them among the threads of the
+  /// calling task arena (withThreads).
+  void insert(const std::vector<IndexedPoint> &input) {
+    delaunay.insert(input.begin(), input.end());
+  }
 
   LockGrid locks; // declared first: built before the triangulation, freed after it
   ParallelDelaunay delaunay;

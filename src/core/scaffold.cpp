@@ -298,7 +298,7 @@ public:
     if (triangulatesInParallel()) {
       detail::ParallelTriangulation parallel(points_);
       {
-        std::vector<detail::IndexedPoint> input = detail::indexedPoints(points_);
+        const std::vector<detail::IndexedPoint> input = detail::indexedPoints(points_);
         detail::withThreads(options_.num_threads, [&] { parallel.insert(input); });
       }
       scaffold_.parallel_triangulation = true;
