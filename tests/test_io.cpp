@@ -427,6 +427,44 @@ TEST_F(IoLoadPointCloud, DataThatReadsAsHeaderLineFails) {
   EXPECT_EQ(std::memcmp(loaded.data.data(), records.data(), records.size()), 0);
 }
 
+// A carriage return after the magic makes PCL's parser break header lines
+// at carriage returns: a header of "\r\n" lines loads as with "\n", one that
+// mixes them (or repeats carriage returns) is refused, as PCL refuses or
+// misreads it (a fuzzer's finding had the MPI tool's reader accept one).
+TEST_F(IoLoadPointCloud, PlyHeaderWithCarriageReturnsLoadsOnlyWhenEveryLineHasOne) {
+  const std::array<float, 6> values = {1.0f, 2.0f, 3.0f, -4.0f, 5.5f, 0.25f};
+  std::string body(sizeof(values), '\0');
+  std::memcpy(body.data(), values.data(), sizeof(values));
+  const std::string lines[] = {"format binary_little_endian 1.0",
+                               "comment from another system",
+                               "element vertex 2",
+                               "property float x",
+                               "property float y",
+                               "property float z",
+                               "end_header"};
+  std::string crlf = "ply\r\n", mixed = "ply\r\n";
+  for (const std::string &line : lines) {
+    crlf += line + "\r\n";
+    mixed += line + "\n";
+  }
+  writeFile(path("crlf.ply"), crlf + body);
+  pcl::PCLPointCloud2 loaded;
+  std::string error;
+  ASSERT_TRUE(pcl_ms::loadPointCloud(path("crlf.ply"), loaded, error)) << error;
+  EXPECT_EQ(loaded.width, 2u);
+  ASSERT_EQ(loaded.data.size(), body.size());
+  EXPECT_EQ(std::memcmp(loaded.data.data(), body.data(), body.size()), 0);
+
+  writeFile(path("mixed.ply"), mixed + body);
+  EXPECT_TRUE(contains(expectCloudFailure(path("mixed.ply")), "does not end in \\r\\n"));
+  writeFile(path("returns.ply"), "ply\r\r\r\n" + crlf.substr(5) + body);
+  EXPECT_TRUE(contains(expectCloudFailure(path("returns.ply")), "magic line"));
+  const std::string fuzzer_finding = readFile(
+      kDataDir + "/../tests/fuzz/corpus/binary_layout/finding_ply_magic_line_of_carriage_returns");
+  writeFile(path("finding.ply"), fuzzer_finding.substr(1)); // its first byte picks PLY
+  EXPECT_TRUE(contains(expectCloudFailure(path("finding.ply")), "magic line"));
+}
+
 TEST_F(IoLoadPointCloud, MissingOrWrongCoordinateFields) {
   writeFile(path("intensity.pcd"), "VERSION 0.7\nFIELDS intensity\nSIZE 4\nTYPE F\nCOUNT 1\n"
                                    "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n1\n2\n");

@@ -266,11 +266,28 @@ bool parsePlyHeader(std::istream &in, PlyHeader &header, std::string &error) {
     error = "not a PLY file (no 'ply' magic line)";
     return false;
   }
+  // A carriage return right after the magic makes PCL's parser break lines
+  // at carriage returns and skip the character after each: only a header
+  // whose every line ends in "\r\n", with no other carriage return, reads
+  // the same both ways (fuzz_binary_layout finding: a magic line of many).
+  const bool breaks_at_carriage_returns = line.size() > 3 && line[3] == '\r';
+  auto endsWithCrLf = [&](const std::string &text) {
+    return !in.eof() && !text.empty() && text.find('\r') == text.size() - 1;
+  };
+  if (breaks_at_carriage_returns && !endsWithCrLf(line)) {
+    error = "PLY magic line: 'ply' followed by more than \\r\\n";
+    return false;
+  }
   std::size_t line_number = 1;
   bool has_format = false;
   while (true) {
     if (!readHeaderLine(in, line, kMaxHeaderLine) || ++line_number > kMaxHeaderLines) {
       error = "incomplete PLY header (no end_header)";
+      return false;
+    }
+    if (breaks_at_carriage_returns && !endsWithCrLf(line)) {
+      error = "PLY header line " + std::to_string(line_number) +
+              ": does not end in \\r\\n like the magic line (or holds another \\r)";
       return false;
     }
     const std::vector<std::string_view> words = splitWords(line);
