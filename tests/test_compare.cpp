@@ -344,6 +344,32 @@ TEST_F(EvaluateApp, ClosedMeshInOffAndObj) {
   }
 }
 
+TEST_F(EvaluateApp, TextReferenceMatchesTheFloatPointsOfAMesh) {
+  // The same tetrahedron twice: as doubles in an OFF file (0.1 is no
+  // float) and as the floats of a PLY file, like the points that PCL reads
+  // and pcl_ms meshes. Vertices are matched at single precision.
+  const std::string corners = "0.1 0.2 0.3\n1.1 0.2 0.3\n0.1 1.3 0.3\n0.1 0.2 1.7\n";
+  writeFile(path("tet.off"), "OFF\n4 4 0\n" + corners + "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  writeFile(path("tet.ply"), "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
+                             "property float y\nproperty float z\nelement face 4\n"
+                             "property list uchar int vertex_indices\nend_header\n" +
+                                 corners + "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  for (const auto &[mesh, other] :
+       {std::pair<const char *, const char *>{"tet.ply", "tet.off"}, {"tet.off", "tet.ply"}}) {
+    SCOPED_TRACE(mesh);
+    ASSERT_EQ(run(kEvaluate, quoted(path(mesh)) + " -gt " + quoted(path(other)) + " -points " +
+                                 quoted(path(other)) + " -json"),
+              0)
+        << stderr_;
+    boost::property_tree::ptree json;
+    std::istringstream text(stdout_);
+    ASSERT_NO_THROW(boost::property_tree::read_json(text, json)) << stdout_;
+    EXPECT_EQ(json.get<double>("reference.recall"), 1.0);
+    EXPECT_EQ(json.get<double>("reference.precision"), 1.0);
+    EXPECT_EQ(json.get<int>("points.input_points_used"), 4);
+  }
+}
+
 TEST_F(EvaluateApp, BadInputFails) {
   const std::string mesh = quoted(kDataDir + "/bun_zipper.ply");
   expectFailure(kEvaluate, "", 1, "one mesh file");

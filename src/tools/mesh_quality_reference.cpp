@@ -7,6 +7,7 @@
 
 #include "mesh_triangles.h"
 #include "morton.h"
+#include "position_keys.h"
 
 #include <CGAL/AABB_segment_primitive.h>
 #include <CGAL/AABB_traits.h>
@@ -75,46 +76,14 @@ std::vector<Triangle> usableTriangles(const std::vector<Eigen::Vector3d> &vertic
   return usable;
 }
 
-std::uint64_t mixBits(std::uint64_t value) {
-  value ^= value >> 33;
-  value *= 0xff51afd7ed558ccdULL;
-  value ^= value >> 33;
-  value *= 0xc4ceb9fe1a85ec53ULL;
-  value ^= value >> 33;
-  return value;
-}
-
-/// Exact-coordinate key; adding 0.0 turns -0.0 into +0.0 so both compare equal.
-struct PositionKey {
-  std::uint64_t bits[3];
-  bool operator==(const PositionKey &other) const {
-    return bits[0] == other.bits[0] && bits[1] == other.bits[1] && bits[2] == other.bits[2];
-  }
-};
-
-PositionKey positionKey(const Eigen::Vector3d &point) {
-  PositionKey key{};
-  for (int axis = 0; axis < 3; ++axis) {
-    const double value = point[axis] + 0.0;
-    std::memcpy(&key.bits[axis], &value, sizeof(value));
-  }
-  return key;
-}
-
-struct PositionKeyHash {
-  std::size_t operator()(const PositionKey &key) const {
-    return static_cast<std::size_t>(
-        mixBits(key.bits[0] ^ mixBits(key.bits[1] ^ mixBits(key.bits[2]))));
-  }
-};
-
 constexpr VertexIndex kUnmatched = std::numeric_limits<VertexIndex>::max();
 
 /// One id per distinct position over both meshes, reference first: ids below
-/// referenceCount() are positions of reference vertices. Exact coincidence
-/// of vertices and triangles between the meshes then is integer comparison.
+/// referenceCount() are positions of reference vertices. Coincidence of
+/// vertices and triangles between the meshes then is integer comparison.
 class PositionIds {
 public:
+  explicit PositionIds(PositionPrecision precision) : precision_(precision) {}
   /// Id per vertex used by a usable triangle, kUnmatched for the others.
   std::vector<VertexIndex> assign(const std::vector<Eigen::Vector3d> &vertices,
                                   const std::vector<Triangle> &usable) {
@@ -122,9 +91,9 @@ public:
     for (const Triangle &triangle : usable)
       for (VertexIndex vertex : triangle)
         if (ids[vertex] == kUnmatched)
-          ids[vertex] =
-              ids_.emplace(positionKey(vertices[vertex]), static_cast<VertexIndex>(ids_.size()))
-                  .first->second;
+          ids[vertex] = ids_.emplace(positionKey(vertices[vertex], precision_),
+                                     static_cast<VertexIndex>(ids_.size()))
+                            .first->second;
     return ids;
   }
   void closeReference() { reference_count_ = ids_.size(); }
@@ -132,6 +101,7 @@ public:
   std::size_t size() const { return ids_.size(); }
 
 private:
+  PositionPrecision precision_;
   std::unordered_map<PositionKey, VertexIndex, PositionKeyHash> ids_;
   std::size_t reference_count_ = 0;
 };
@@ -512,8 +482,8 @@ ReferenceReport compareWithReference(const std::vector<Eigen::Vector3d> &vertice
     report.reference_diagonal = (high - low).norm();
   }
 
-  // Exact coincidence, as triples of shared position ids.
-  PositionIds positions;
+  // Coincidence, as triples of shared position ids.
+  PositionIds positions(matchingPrecision(vertices, reference_vertices));
   const std::vector<VertexIndex> reference_ids =
       positions.assign(reference_vertices, reference_usable);
   positions.closeReference();

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "mesh_report.h"
 
+#include "position_keys.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -31,17 +33,6 @@ std::string printed(const char *format, double value) {
   std::snprintf(buffer, sizeof(buffer), format, value);
   return buffer;
 }
-
-/// Exact float positions as hash keys: the tools compare positions bit for
-/// bit, like compareWithReference with zero tolerance.
-struct PositionHash {
-  std::size_t operator()(const std::array<double, 3> &p) const {
-    std::size_t seed = 0;
-    for (double c : p)
-      seed ^= std::hash<double>()(c) + 0x9e3779b97f4a7c15ull + (seed << 6) + (seed >> 2);
-    return seed;
-  }
-};
 
 } // namespace
 
@@ -117,15 +108,17 @@ std::vector<Metric> referenceMetrics(const pcl_ms::ReferenceReport *report) {
 PointUsage pointsUsedAsVertices(const std::vector<Eigen::Vector3d> &points,
                                 const std::vector<Eigen::Vector3d> &vertices,
                                 const std::vector<pcl_ms::Triangle> &triangles) {
-  std::unordered_set<std::array<double, 3>, PositionHash> used;
+  using namespace pcl_ms::metrics_detail;
+  const PositionPrecision precision = matchingPrecision(points, vertices);
+  std::unordered_set<PositionKey, PositionKeyHash> used;
   for (const pcl_ms::Triangle &triangle : triangles)
     for (pcl_ms::VertexIndex v : triangle)
       if (v < vertices.size())
-        used.insert({vertices[v].x(), vertices[v].y(), vertices[v].z()});
+        used.insert(positionKey(vertices[v], precision));
   PointUsage usage;
   usage.points = points.size();
   for (const Eigen::Vector3d &p : points)
-    usage.used += used.count({p.x(), p.y(), p.z()});
+    usage.used += used.count(positionKey(p, precision));
   return usage;
 }
 

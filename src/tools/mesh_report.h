@@ -44,8 +44,9 @@ std::vector<Metric> topologyMetrics(const pcl_ms::MeshTopologyReport &report);
 std::vector<Metric> referenceMetrics(const pcl_ms::ReferenceReport *report);
 
 /// How many of `points` are vertices of a triangle of the mesh, matched by
-/// exact position (an interpolating mesh uses its input points; Poisson's
-/// new vertices match none).
+/// position at single precision where that keeps each input's positions
+/// apart, else bit for bit (position_keys.h): an interpolating mesh uses its
+/// input points; Poisson's new vertices match none.
 struct PointUsage {
   std::size_t points = 0;
   std::size_t used = 0;

@@ -377,6 +377,35 @@ TEST(MeshQualityReference, MatchingIgnoresVertexAndCornerOrder) {
   EXPECT_NEAR(report.reference_diagonal, std::sqrt(3.0), 1e-15);
 }
 
+TEST(MeshQualityReference, DoubleReferenceMatchesTheFloatsMeshedFromIt) {
+  // A reference read from text holds doubles (1/12 is no float); the cloud
+  // meshed from it, and so the mesh, holds their float roundings.
+  const Mesh reference = bumpyGrid(12);
+  Mesh ours = reference;
+  for (Eigen::Vector3d &vertex : ours.vertices)
+    vertex = vertex.cast<float>().cast<double>();
+  ASSERT_NE(ours.vertices[1], reference.vertices[1]);
+  const ReferenceReport report = compare(ours, reference);
+  EXPECT_EQ(report.recall, 1.0);
+  EXPECT_EQ(report.precision, 1.0);
+}
+
+TEST(MeshQualityReference, PositionsThatRoundingWouldMergeAreComparedBitForBit) {
+  // Floats lie 8 apart at 1e8: rounded, vertices 0 and 1 would be one
+  // position, and our triangle on vertex 1 would pass for the reference's
+  // on vertex 0.
+  Mesh reference;
+  reference.vertices = {
+      {1e8, 0, 0}, {1e8 + 1, 0, 0}, {1e8, 100, 0}, {1e8 + 100, 0, 0}, {1e8 + 50, -100, 0}};
+  reference.triangles = {{0, 3, 2}, {1, 4, 3}};
+  Mesh ours = reference;
+  ours.triangles = {{1, 3, 2}, {1, 4, 3}};
+  const ReferenceReport report = compare(ours, reference);
+  EXPECT_EQ(report.recovered_reference_triangles, 1u);
+  EXPECT_EQ(report.recall, 0.5);
+  EXPECT_EQ(report.precision, 0.5);
+}
+
 TEST(MeshQualityReference, ShiftAlongTheNormal) {
   const Mesh reference = flatGrid(10);
   const double diagonal = std::sqrt(2.0);

@@ -91,8 +91,12 @@ struct ReferenceOptions {
   /// (every referenced vertex, every triangle centroid, every edge midpoint).
   std::size_t surface_samples = 200000;
   std::uint32_t seed = 1; // fixed for reproducibility
-  /// Vertex matching: 0 = identical coordinates, else the largest distance
-  /// (absolute units) to the nearest reference vertex.
+  /// Vertex matching: 0 = the same coordinates, compared rounded to float
+  /// (the precision of PCL's clouds, so that a reference read as doubles
+  /// from text matches the float points meshed from it) unless rounding
+  /// would merge two distinct positions of one mesh, and then bit for bit;
+  /// else the largest distance (absolute units) to the nearest reference
+  /// vertex.
   double position_tolerance = 0;
   /// true: mean, p95 and the F-scores come from the area-uniform samples only,
   /// so they do not depend on how finely either mesh is tessellated (vertices
@@ -115,9 +119,10 @@ struct ReferenceReport {
   /// distances are reported in absolute units and tau is 0.
   double reference_diagonal = 0;
   std::size_t reference_triangles = 0;
-  /// Reference triangles whose three vertices, matched by position, form one
-  /// of our triangles (any order or orientation). Reference vertices at the
-  /// same coordinates count as one position.
+  /// Reference triangles whose three vertices, matched by position (see
+  /// position_tolerance), form one of our triangles (any order or
+  /// orientation). Reference vertices at the same coordinates count as one
+  /// position.
   std::size_t recovered_reference_triangles = 0;
   std::size_t triangles = 0;              // ours
   std::size_t triangles_in_reference = 0; // ours that are reference triangles
