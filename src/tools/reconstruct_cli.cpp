@@ -96,7 +96,9 @@ void printReconstructHelp(const char *program, const char *summary) {
   print_info(" above ");
   print_value("%zu", pcl_ms::automatic_bucketing_threshold);
   print_info(" points (default 0)\n");
-  print_info("  -grid N         cut the bounding box into N x N x N buckets instead\n");
+  print_info("  -grid N         cut the bounding box into N x N x N buckets instead; each\n"
+             "                  meshes a margin of its neighbours' points too, so buckets of\n"
+             "                  far fewer points than the default mesh most points many times\n");
   print_info("  -viewpoint X,Y,Z  where a one-view scan was taken from: open surfaces face it\n"
              "                  and are never left one-sided (default: the sensor origin (PCD\n"
              "                  VIEWPOINT) of an organized cloud, i.e. a depth frame, or a\n"
