@@ -15,7 +15,6 @@
 #include <array>
 #include <cstdint>
 #include <cstring>
-#include <utility>
 #include <vector>
 
 namespace pcl_ms {
@@ -29,7 +28,6 @@ enum class PositionPrecision { single, exact };
 struct PositionKey {
   std::array<std::uint64_t, 3> bits{};
   bool operator==(const PositionKey &other) const { return bits == other.bits; }
-  bool operator<(const PositionKey &other) const { return bits < other.bits; }
 };
 
 inline PositionKey positionKey(const Eigen::Vector3d &point, PositionPrecision precision) {
@@ -66,19 +64,30 @@ struct PositionKeyHash {
 };
 
 /// Whether rounding to float leaves the distinct positions among `positions`
-/// distinct (non-finite ones are left out: no metric matches them).
+/// distinct (non-finite ones are left out: no metric matches them). Sorted
+/// as 16-byte records, float coordinates and index, to spare the memory of
+/// full keys on meshes of millions of vertices.
 inline bool roundingKeepsApart(const std::vector<Eigen::Vector3d> &positions) {
-  std::vector<std::pair<PositionKey, std::uint32_t>> rounded;
+  struct Rounded {
+    std::array<std::uint32_t, 3> bits;
+    std::uint32_t index;
+  };
+  std::vector<Rounded> rounded;
   rounded.reserve(positions.size());
   for (std::size_t i = 0; i < positions.size(); ++i)
-    if (positions[i].allFinite())
-      rounded.emplace_back(positionKey(positions[i], PositionPrecision::single),
-                           static_cast<std::uint32_t>(i));
-  std::sort(rounded.begin(), rounded.end());
+    if (positions[i].allFinite()) {
+      const PositionKey key = positionKey(positions[i], PositionPrecision::single);
+      rounded.push_back(
+          {{static_cast<std::uint32_t>(key.bits[0]), static_cast<std::uint32_t>(key.bits[1]),
+            static_cast<std::uint32_t>(key.bits[2])},
+           static_cast<std::uint32_t>(i)});
+    }
+  std::sort(rounded.begin(), rounded.end(),
+            [](const Rounded &a, const Rounded &b) { return a.bits < b.bits; });
   for (std::size_t i = 1; i < rounded.size(); ++i)
-    if (rounded[i].first == rounded[i - 1].first &&
-        !(positionKey(positions[rounded[i].second], PositionPrecision::exact) ==
-          positionKey(positions[rounded[i - 1].second], PositionPrecision::exact)))
+    if (rounded[i].bits == rounded[i - 1].bits &&
+        !(positionKey(positions[rounded[i].index], PositionPrecision::exact) ==
+          positionKey(positions[rounded[i - 1].index], PositionPrecision::exact)))
       return false;
   return true;
 }
