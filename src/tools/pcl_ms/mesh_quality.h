@@ -141,10 +141,11 @@ struct ReferenceReport {
 ///  - F-score at tau: precision P = share of our samples within tau of the
 ///    reference, recall R = share of reference samples within tau of ours,
 ///    F = 2PR / (P + R), 0 when both are 0.
-///  - Samples that coincide exactly with the other mesh (a vertex at the
-///    same coordinates, or a point of a triangle the other mesh has with the
-///    same three corner coordinates) get distance exactly 0 without a query,
-///    which makes comparing nearly identical meshes cheap.
+///  - Samples that coincide with the other mesh (a vertex at the same
+///    position, or a point of a triangle the other mesh has with the same
+///    three corners, positions matched as for recall, see
+///    position_tolerance) get distance exactly 0 without a query, which
+///    makes comparing nearly identical meshes cheap.
 ///  - Triangles with an index out of range or a non-finite corner are left
 ///    out of matching and distances, but still count in `triangles` and
 ///    `reference_triangles`, so they lower precision and recall.
