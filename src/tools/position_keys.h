@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Vertex positions as hash keys, for the metrics that match vertices of two
-// meshes (or a mesh and a cloud) by position. The points every method meshes
+// meshes (or a mesh and a cloud) by position, and for pcl_ms_reconstruct's
+// -initial mesh, matched to the cloud's points. The points every method meshes
 // are PCL's floats, but a reference read from text (.off, .obj) and a mesh
 // written as 9-digit text come back as doubles that are not those floats:
 // compared bit for bit they never match. So positions are compared rounded

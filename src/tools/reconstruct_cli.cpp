@@ -3,6 +3,7 @@
 
 #include "finite_vertices.h"
 #include "normal_estimation.h"
+#include "position_keys.h"
 
 #include <pcl_ms/buckets.h>
 #include <pcl_ms/io.h>
@@ -15,7 +16,6 @@
 #include <pcl/point_types.h>
 
 #include <algorithm>
-#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <unordered_map>
@@ -332,27 +332,24 @@ int loadInitialTriangles(const ReconstructOptions &options, const pcl::PCLPointC
   }
   pcl::PointCloud<pcl::PointXYZ> points;
   pcl::fromPCLPointCloud2(cloud, points);
-  // Input point of each position; the first of repeated ones.
-  struct PositionHash {
-    std::size_t operator()(const std::array<float, 3> &p) const {
-      std::size_t hash = 0;
-      for (float value : p)
-        hash = hash * 1000003u ^ std::hash<float>()(value);
-      return hash;
-    }
-  };
-  std::unordered_map<std::array<float, 3>, pcl::index_t, PositionHash> point_at;
+  // Input point of each position, the first of repeated ones. The points
+  // are floats, so vertices are matched rounded to float (position_keys.h).
+  using pcl_ms::metrics_detail::PositionPrecision;
+  std::unordered_map<pcl_ms::metrics_detail::PositionKey, pcl::index_t,
+                     pcl_ms::metrics_detail::PositionKeyHash>
+      point_at;
   point_at.reserve(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i)
-    point_at.emplace(std::array<float, 3>{points[i].x, points[i].y, points[i].z},
-                     static_cast<pcl::index_t>(i));
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d point = points[i].getVector3fMap().cast<double>();
+    if (point.allFinite()) // no vertex is at NaN
+      point_at.emplace(pcl_ms::metrics_detail::positionKey(point, PositionPrecision::single),
+                       static_cast<pcl::index_t>(i));
+  }
   std::vector<pcl::index_t> point_of_vertex(vertices.size(), -1);
   std::size_t unmatched = 0;
   for (std::size_t v = 0; v < vertices.size(); ++v) {
-    const std::array<float, 3> position = {static_cast<float>(vertices[v].x()),
-                                           static_cast<float>(vertices[v].y()),
-                                           static_cast<float>(vertices[v].z())};
-    const auto found = point_at.find(position);
+    const auto found =
+        point_at.find(pcl_ms::metrics_detail::positionKey(vertices[v], PositionPrecision::single));
     if (found != point_at.end())
       point_of_vertex[v] = found->second;
     else
