@@ -67,10 +67,7 @@ template <typename Triangulation>
 bool isGabriel(const Triangulation &delaunay, typename Triangulation::Cell_handle cell, int i,
                const std::array<typename Triangulation::Vertex_handle, 3> &vertices) {
   const auto side_of_bounded_sphere = Kernel().side_of_bounded_sphere_3_object();
-  const auto neighbour = cell->neighbor(i);
-  const typename Triangulation::Vertex_handle opposite[2] = {
-      cell->vertex(i), neighbour->vertex(neighbour->index(cell))};
-  for (const auto &apex : opposite) {
+  for (const auto &apex : {cell->vertex(i), delaunay.mirror_vertex(cell, i)}) {
     if (delaunay.is_infinite(apex))
       continue;
     if (side_of_bounded_sphere(vertices[0]->point(), vertices[1]->point(), vertices[2]->point(),
@@ -107,10 +104,7 @@ bool isGabriel(const Triangulation &delaunay, typename Triangulation::Cell_handl
   if (needle)
     return isGabriel(delaunay, cell, i, vertices);
   const double margin = fast_gabriel_margin * radius_squared;
-  const auto neighbour = cell->neighbor(i);
-  const typename Triangulation::Vertex_handle opposite[2] = {
-      cell->vertex(i), neighbour->vertex(neighbour->index(cell))};
-  for (const auto &apex : opposite) {
+  for (const auto &apex : {cell->vertex(i), delaunay.mirror_vertex(cell, i)}) {
     if (delaunay.is_infinite(apex))
       continue;
     const KernelPoint &p = apex->point();

@@ -341,7 +341,8 @@ int loadInitialTriangles(const ReconstructOptions &options, const pcl::PCLPointC
   point_at.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3d point = points[i].getVector3fMap().cast<double>();
-    if (point.allFinite()) // no vertex is at NaN
+    // The reconstruction skips non-finite points, so no vertex may stand on one.
+    if (point.allFinite())
       point_at.emplace(pcl_ms::metrics_detail::positionKey(point, PositionPrecision::single),
                        static_cast<pcl::index_t>(i));
   }
