@@ -327,3 +327,40 @@ TEST_F(AppInitial, ReconstructTakesAnInitialMeshInEitherMode) {
             0);
   EXPECT_TRUE(contains(stderr_, "needs -initial")) << stderr_;
 }
+
+TEST_F(AppInitial, VertexAtInfinityIsNotAPointOfTheCloud) {
+  // The reconstruction skips non-finite points, so an -initial vertex at
+  // +inf must not be matched to the cloud's point at +inf.
+  const std::string app = std::string(PCL_MS_BINARY_DIR) + "/pcl_ms_reconstruct";
+  ASSERT_TRUE(fs::exists(app)) << app << " was not built";
+  writeFile(path("cloud.pcd"), "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n"
+                               "COUNT 1 1 1\nWIDTH 5\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
+                               "POINTS 5\nDATA ascii\n0 0 0\n1 0 0\n0 1 0\ninf 0 0\n1 1 0.1\n");
+  writeFile(path("mesh.off"), "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\ninf 0 0\n3 0 1 2\n3 1 2 3\n");
+  const std::string files = quoted(path("cloud.pcd")) + " " + quoted(path("out.ply")) +
+                            " -initial " + quoted(path("mesh.off"));
+
+  EXPECT_EQ(runProgram(app, files + " -q"), 1) << stderr_;
+  EXPECT_TRUE(contains(stderr_, "vertex 3 of triangle 1 of ")) << stderr_;
+  EXPECT_TRUE(contains(stderr_, "is not a point of")) << stderr_;
+  EXPECT_FALSE(fs::exists(path("out.ply")));
+
+  // Preferred mode leaves the triangle out and keeps the finite one.
+  ASSERT_EQ(runProgram(app, files + " -initial_mode preferred"), 0) << stderr_;
+  EXPECT_TRUE(contains(stdout_, "1 vertices not in the input")) << stdout_;
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<Triangle> triangles;
+  std::string error;
+  ASSERT_TRUE(pcl_ms::loadMesh(path("out.ply"), vertices, triangles, error)) << error;
+  for (const Eigen::Vector3d &vertex : vertices)
+    EXPECT_TRUE(vertex.allFinite()) << vertex.transpose();
+  const auto corner = [&](const Eigen::Vector3d &position) {
+    for (std::size_t v = 0; v < vertices.size(); ++v)
+      if (vertices[v] == position)
+        return static_cast<pcl_ms::VertexIndex>(v);
+    return static_cast<pcl_ms::VertexIndex>(vertices.size());
+  };
+  const Triangle kept = sorted({corner({0, 0, 0}), corner({1, 0, 0}), corner({0, 1, 0})});
+  ASSERT_LT(kept[2], vertices.size());
+  EXPECT_EQ(sortedSet(triangles).count(kept), 1u);
+}
