@@ -31,6 +31,33 @@ inline std::size_t unevenCut(std::size_t count, std::size_t p, std::size_t proce
   return count * p * p / (processes * processes);
 }
 
+/// How the points are cut into home slices: evenly, or as unevenCut does.
+enum class HomeCut { even, uneven };
+
+/// One process's home slice: its first point's index, its points and, when
+/// the test has local scales, theirs.
+struct HomeSlice {
+  std::size_t begin = 0;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<float> scales;
+};
+
+/// Home slice p of `points` (and of `scales` when it is not empty) among
+/// `processes`.
+inline HomeSlice homeSlice(const std::vector<Eigen::Vector3d> &points, std::size_t p, int processes,
+                           HomeCut cut, const std::vector<float> &scales = {}) {
+  const auto count = static_cast<std::size_t>(processes);
+  const auto at = [&](std::size_t q) {
+    return cut == HomeCut::even ? points.size() * q / count : unevenCut(points.size(), q, count);
+  };
+  HomeSlice home;
+  home.begin = at(p);
+  home.points = sliceOf(points, home.begin, at(p + 1));
+  if (!scales.empty())
+    home.scales = sliceOf(scales, home.begin, at(p + 1));
+  return home;
+}
+
 /// Local scales that vary from point to point, so that the size limit of
 /// hole filling refuses some fillings of the bunny's holes.
 inline std::vector<float> varyingScales(std::size_t count) {
@@ -53,24 +80,29 @@ std::vector<pcl_ms::Triangle> bunnyPatchWithout(const TakenOut &taken_out) {
   return patch;
 }
 
-/// What the orientation steps in parts start from, for one process's run.
+/// What the orientation steps in parts start from, for one process: its
+/// run of the triangles, their edge scan, components and corner points.
 struct OrientationInputs {
+  std::vector<pcl_ms::Triangle> mine;
   pcl_ms::detail::MeshEdgesPart edges;
   pcl_ms::detail::ComponentsPart components;
   pcl_ms::detail::CornerPoints corners;
 };
 
-/// The edge scan, the components and the corner points of run `mine` (from
-/// triangle `first` on), with its home slice of the points from `home_first`.
-inline OrientationInputs orientationInputs(const std::vector<pcl_ms::Triangle> &mine,
-                                           std::uint64_t first,
-                                           const std::vector<Eigen::Vector3d> &home,
-                                           std::uint64_t home_first, std::uint64_t point_count,
-                                           pcl_ms::ProcessGroup &group) {
+/// The orientation inputs of `group`'s process when the triangles are cut
+/// into runs at `cuts` and the points into home slices by `home_cut`.
+inline OrientationInputs orientationInputs(const std::vector<pcl_ms::Triangle> &triangles,
+                                           const std::vector<std::size_t> &cuts,
+                                           const std::vector<Eigen::Vector3d> &points,
+                                           HomeCut home_cut, pcl_ms::ProcessGroup &group) {
+  const auto p = static_cast<std::size_t>(group.process());
+  const HomeSlice home = homeSlice(points, p, group.processes(), home_cut);
   OrientationInputs inputs;
-  inputs.edges = pcl_ms::detail::meshEdgesInParts(mine, first, point_count, group);
-  inputs.components = pcl_ms::detail::componentsInParts(mine, first, inputs.edges, group);
-  inputs.corners = pcl_ms::detail::cornerPointsFromHomes(mine, home, home_first, group);
+  inputs.mine = sliceOf(triangles, cuts[p], cuts[p + 1]);
+  inputs.edges = pcl_ms::detail::meshEdgesInParts(inputs.mine, cuts[p], points.size(), group);
+  inputs.components = pcl_ms::detail::componentsInParts(inputs.mine, cuts[p], inputs.edges, group);
+  inputs.corners =
+      pcl_ms::detail::cornerPointsFromHomes(inputs.mine, home.points, home.begin, group);
   return inputs;
 }
 

@@ -125,13 +125,9 @@ TEST(ConflictsInParts, CutsAreThoseOfOneProcessForAnySplitWithOrWithoutAViewpoin
       std::vector<std::vector<std::uint64_t>> chosen(static_cast<std::size_t>(processes));
       pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
         const auto p = static_cast<std::size_t>(group.process());
-        const std::vector<Triangle> mine = pcl_ms_test::sliceOf(triangles, cuts[p], cuts[p + 1]);
-        const std::size_t home_begin = points.size() * p / processes,
-                          home_end = points.size() * (p + 1) / processes;
-        const std::vector<Eigen::Vector3d> home =
-            pcl_ms_test::sliceOf(points, home_begin, home_end);
-        const pcl_ms_test::OrientationInputs inputs =
-            pcl_ms_test::orientationInputs(mine, cuts[p], home, home_begin, points.size(), group);
+        const pcl_ms_test::OrientationInputs inputs = pcl_ms_test::orientationInputs(
+            triangles, cuts, points, pcl_ms_test::HomeCut::even, group);
+        const std::vector<Triangle> &mine = inputs.mine;
         const detail::MeshEdgesPart &edges = inputs.edges;
         const detail::ComponentsPart &components = inputs.components;
         const detail::CornerPoints &corners = inputs.corners;

@@ -92,13 +92,10 @@ TEST(FinishInParts, TheSurfaceIsOneProcesssForAnySplitWithOrWithoutAViewpoint) {
       pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
         const auto p = static_cast<std::size_t>(group.process());
         const std::vector<Triangle> mine = pcl_ms_test::sliceOf(triangles, cuts[p], cuts[p + 1]);
-        const std::size_t home_begin = pcl_ms_test::unevenCut(point_count, p, processes),
-                          home_end = pcl_ms_test::unevenCut(point_count, p + 1, processes);
-        const std::vector<Eigen::Vector3d> home =
-            pcl_ms_test::sliceOf(points, home_begin, home_end);
-        const std::vector<float> home_scales = pcl_ms_test::sliceOf(scales, home_begin, home_end);
-        parts[p] = detail::finishInParts(mine, cuts[p], home, home_scales, home_begin, max_edges,
-                                         rho, view, group);
+        const pcl_ms_test::HomeSlice home =
+            pcl_ms_test::homeSlice(points, p, processes, pcl_ms_test::HomeCut::uneven, scales);
+        parts[p] = detail::finishInParts(mine, cuts[p], home.points, home.scales, home.begin,
+                                         max_edges, rho, view, group);
       });
       std::vector<Triangle> finished;
       // Components numbered by their first triangles, as one process numbers them.

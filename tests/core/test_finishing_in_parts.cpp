@@ -470,7 +470,7 @@ TEST(SidesInParts, TurnsAreThoseOfOneProcessForAnySplitWithOrWithoutAViewpoint) 
   appendGridThroughOrigin(30, points, triangles);
   const std::size_t nudged_first = triangles.size();
   appendGridThroughOrigin(21, points, triangles, -1e-28);
-  const std::size_t n = triangles.size(), point_count = points.size();
+  const std::size_t n = triangles.size();
   // Both grids' sums are too close to zero for their rounding bound; the
   // first grid's are zero, the nudged one's not (its volume negative and
   // its facing of the origin positive: each turns the grid in one case).
@@ -518,14 +518,10 @@ TEST(SidesInParts, TurnsAreThoseOfOneProcessForAnySplitWithOrWithoutAViewpoint) 
       std::vector<std::vector<std::uint8_t>> turned(static_cast<std::size_t>(processes));
       pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
         const auto p = static_cast<std::size_t>(group.process());
-        const std::vector<Triangle> mine = pcl_ms_test::sliceOf(triangles, cuts[p], cuts[p + 1]);
         // Home slices cut elsewhere than the runs, the first one empty.
-        const std::size_t home_begin = pcl_ms_test::unevenCut(point_count, p, processes),
-                          home_end = pcl_ms_test::unevenCut(point_count, p + 1, processes);
-        const std::vector<Eigen::Vector3d> home =
-            pcl_ms_test::sliceOf(points, home_begin, home_end);
-        const pcl_ms_test::OrientationInputs inputs =
-            pcl_ms_test::orientationInputs(mine, cuts[p], home, home_begin, point_count, group);
+        const pcl_ms_test::OrientationInputs inputs = pcl_ms_test::orientationInputs(
+            triangles, cuts, points, pcl_ms_test::HomeCut::uneven, group);
+        const std::vector<Triangle> &mine = inputs.mine;
         const detail::MeshEdgesPart &edges = inputs.edges;
         const detail::ComponentsPart &components = inputs.components;
         const detail::CornerPoints &corners = inputs.corners;
@@ -739,14 +735,10 @@ TEST(TwistsInParts, ForestTurnsAndConflictsAreThoseOfOneProcessForAnySplit) {
       std::vector<detail::TwistsPart> parts(static_cast<std::size_t>(processes));
       pcl_ms_test::onThreadProcesses(processes, [&](ProcessGroup &group) {
         const auto p = static_cast<std::size_t>(group.process());
-        const std::vector<Triangle> mine = pcl_ms_test::sliceOf(triangles, cuts[p], cuts[p + 1]);
         // Home slices cut evenly, elsewhere than the runs.
-        const std::size_t home_begin = points.size() * p / processes,
-                          home_end = points.size() * (p + 1) / processes;
-        const std::vector<Eigen::Vector3d> home =
-            pcl_ms_test::sliceOf(points, home_begin, home_end);
-        const pcl_ms_test::OrientationInputs inputs =
-            pcl_ms_test::orientationInputs(mine, cuts[p], home, home_begin, points.size(), group);
+        const pcl_ms_test::OrientationInputs inputs = pcl_ms_test::orientationInputs(
+            triangles, cuts, points, pcl_ms_test::HomeCut::even, group);
+        const std::vector<Triangle> &mine = inputs.mine;
         const detail::MeshEdgesPart &edges = inputs.edges;
         const detail::ComponentsPart &components = inputs.components;
         const detail::CornerPoints &corners = inputs.corners;

@@ -85,11 +85,8 @@ TEST(HolesInParts, FillingsAndLoopsAreThoseOfOneProcessForAnySplit) {
         const auto p = static_cast<std::size_t>(group.process());
         const std::vector<Triangle> mine = pcl_ms_test::sliceOf(triangles, cuts[p], cuts[p + 1]);
         // Home slices cut elsewhere than the runs, the first one empty.
-        const std::size_t home_begin = pcl_ms_test::unevenCut(point_count, p, processes),
-                          home_end = pcl_ms_test::unevenCut(point_count, p + 1, processes);
-        const std::vector<Eigen::Vector3d> home =
-            pcl_ms_test::sliceOf(points, home_begin, home_end);
-        const std::vector<float> home_scales = pcl_ms_test::sliceOf(scales, home_begin, home_end);
+        const pcl_ms_test::HomeSlice home =
+            pcl_ms_test::homeSlice(points, p, processes, pcl_ms_test::HomeCut::uneven, scales);
         // The processes before the last mark a share of the vertices each;
         // the last (of several) gives no list.
         const std::size_t listing = processes > 1 ? static_cast<std::size_t>(processes) - 1 : 1;
@@ -100,8 +97,8 @@ TEST(HolesInParts, FillingsAndLoopsAreThoseOfOneProcessForAnySplit) {
             around.push_back(v);
         const detail::MeshEdgesPart edges =
             detail::meshEdgesInParts(mine, cuts[p], point_count, group);
-        parts[p] = detail::fillHolesInParts(mine, edges, home, home_scales, home_begin, max_edges,
-                                            rho, gives_list ? &around : nullptr, group);
+        parts[p] = detail::fillHolesInParts(mine, edges, home.points, home.scales, home.begin,
+                                            max_edges, rho, gives_list ? &around : nullptr, group);
       });
       for (int p = 0; p < processes; ++p) {
         SCOPED_TRACE("process " + std::to_string(p));
