@@ -403,6 +403,18 @@ TEST_F(RenderTest, RenderBunnyShowsBaseHoles) {
   EXPECT_EQ(picture.count(isRed), 0);
 }
 
+// Renders one triangle and exits: status 0 with the error on stderr if the
+// rendering failed, as the death tests below expect, 1 if it succeeded.
+[[noreturn]] void renderOneTriangleAndExit() {
+  const Mesh mesh = singleTriangle();
+  std::string error;
+  const bool rendered = pcl_ms_tools::renderMeshPng(
+      mesh.vertices, mesh.triangles, pcl_ms_tools::viewFramingPoints(mesh.vertices), {},
+      (fs::temp_directory_path() / "pcl_ms_render_never.png").string(), error);
+  std::cerr << error << std::endl;
+  std::exit(rendered ? 1 : 0);
+}
+
 // Runs in a fresh copy of the test program (threadsafe death test), so the
 // display this process may already use does not count.
 TEST(RenderDeathTest, RenderWithoutDisplayOrXvfbFailsWithPackageName) {
@@ -410,13 +422,7 @@ TEST(RenderDeathTest, RenderWithoutDisplayOrXvfbFailsWithPackageName) {
   const auto render_without_xvfb = [] {
     ::unsetenv("DISPLAY");
     ::setenv("PATH", "/nonexistent", 1);
-    const Mesh mesh = singleTriangle();
-    std::string error;
-    const bool rendered = pcl_ms_tools::renderMeshPng(
-        mesh.vertices, mesh.triangles, pcl_ms_tools::viewFramingPoints(mesh.vertices), {},
-        (fs::temp_directory_path() / "pcl_ms_render_never.png").string(), error);
-    std::cerr << error << std::endl;
-    std::exit(rendered ? 1 : 0);
+    renderOneTriangleAndExit();
   };
   EXPECT_EXIT(render_without_xvfb(), ::testing::ExitedWithCode(0),
               "DISPLAY is not set, and Xvfb is not installed \\(Debian package xvfb\\)");
@@ -428,13 +434,7 @@ TEST(RenderDeathTest, RenderWithoutUsableOpenGLFailsInsteadOfCrashing) {
     // Indirect GLX offers OpenGL 1.4 at most, and Xvfb refuses the context.
     ::unsetenv("DISPLAY");
     ::setenv("LIBGL_ALWAYS_INDIRECT", "1", 1);
-    const Mesh mesh = singleTriangle();
-    std::string error;
-    const bool rendered = pcl_ms_tools::renderMeshPng(
-        mesh.vertices, mesh.triangles, pcl_ms_tools::viewFramingPoints(mesh.vertices), {},
-        (fs::temp_directory_path() / "pcl_ms_render_never.png").string(), error);
-    std::cerr << error << std::endl;
-    std::exit(rendered ? 1 : 0);
+    renderOneTriangleAndExit();
   };
   EXPECT_EXIT(render_with_indirect_gl(), ::testing::ExitedWithCode(0), "no OpenGL on");
 }
